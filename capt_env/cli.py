@@ -1,0 +1,44 @@
+"""The ``capt`` command line: one console script, one verb per job.
+
+Every verb prints a human summary and, with ``--json PATH``, writes its numbers as JSON. Verbs import
+their heavy dependencies lazily, so ``capt --help`` and ``capt doctor`` stay fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+# verb -> (module under capt_env.commands, one-line help)
+VERBS: dict[str, tuple[str, str]] = {
+    "doctor": ("doctor", "rendering device SAPIEN sees, versions, and what to install"),
+    "demo": ("demo", "the main job: render unseen objects, estimate and open them, save pictures"),
+    "generate": ("generate", "render a labelled point-cloud dataset of one category as shards"),
+    "bench": ("bench", "environment speed: steps/s in state and pointcloud mode, reset time"),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="capt", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
+    for verb, (module, help_text) in VERBS.items():
+        mod = importlib.import_module(f"capt_env.commands.{module}")
+        p = sub.add_parser(verb, help=help_text, description=help_text)
+        mod.add_arguments(p)
+        p.add_argument("--json", metavar="PATH", default=None, help="also write the numbers as JSON here")
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args._run(args) or 0)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

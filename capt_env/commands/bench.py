@@ -1,0 +1,67 @@
+"""``capt bench``: environment speed on this machine (steps/s per obs mode, reset time)."""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+from tqdm import tqdm
+
+from capt_env.commands.json_output import write_json
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--category", default="laptop", help="object category (default: laptop)")
+    parser.add_argument("--steps", type=int, default=200, help="random-action steps per obs mode")
+    parser.add_argument("--resets", type=int, default=5, help="resets (each builds a new object)")
+    parser.add_argument("--obs-modes", nargs="+", default=["state", "pointcloud"])
+    parser.add_argument("--width", type=int, default=128, help="camera width and height in pixels")
+    parser.add_argument("--seed", type=int, default=0)
+
+
+def measure(category: str, obs_mode: str, steps: int, resets: int, width: int, seed: int) -> dict:
+    """Median reset time (s) and steady-state steps/s of one obs mode; the first reset is reported apart."""
+    import gymnasium as gym
+
+    import capt_env  # noqa: F401
+
+    task = {"cameras": [{"width": width, "height": width}]}
+    t0 = time.perf_counter()
+    env = gym.make(capt_env.env_id(category), obs_mode=obs_mode, task=task)
+    env.reset(seed=seed)
+    first = time.perf_counter() - t0
+    times = []
+    for i in range(resets):
+        t = time.perf_counter()
+        env.reset(seed=seed + 1 + i)
+        times.append(time.perf_counter() - t)
+    env.action_space.seed(seed)
+    for _ in range(5):  # warm-up
+        env.step(env.action_space.sample())
+    t = time.perf_counter()
+    for _ in tqdm(range(steps), desc=f"{obs_mode} steps", leave=False):
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+    elapsed = time.perf_counter() - t
+    env.close()
+    return {
+        "obs_mode": obs_mode,
+        "steps_per_second": steps / elapsed,
+        "ms_per_step": 1000 * elapsed / steps,
+        "reset_seconds_median": statistics.median(times),
+        "first_make_and_reset_seconds": first,
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    results = []
+    for mode in args.obs_modes:
+        r = measure(args.category, mode, args.steps, args.resets, args.width, args.seed)
+        results.append(r)
+        print(f"{args.category:<15} {mode:<11} {r['steps_per_second']:7.1f} steps/s "
+              f"({r['ms_per_step']:.1f} ms/step)  reset {r['reset_seconds_median']:.2f} s "
+              f"(first make+reset {r['first_make_and_reset_seconds']:.1f} s)")
+    write_json(args.json, {"category": args.category, "camera_pixels": args.width**2, "results": results})
+    return 0

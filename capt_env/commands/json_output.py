@@ -1,0 +1,42 @@
+"""Write a command's numbers as JSON (atomically), with the machine and versions that produced them."""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+
+def machine_info() -> dict[str, Any]:
+    """The machine and software a number was measured on."""
+    info: dict[str, Any] = {
+        "python": sys.version.split()[0],
+        "platform": platform.platform(),
+        "processor": platform.processor() or platform.machine(),
+        "cpu_count": os.cpu_count(),
+    }
+    for mod in ("torch", "sapien", "mani_skill", "gymnasium", "numpy"):
+        try:
+            info[mod] = __import__(mod).__version__
+        except Exception:  # noqa: BLE001 - a missing module is reported as such
+            info[mod] = None
+    return info
+
+
+def write_json(path: str | os.PathLike | None, payload: dict[str, Any]) -> None:
+    """Write ``payload`` plus ``machine`` to ``path`` (no-op when path is None)."""
+    if path is None:
+        return
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data = {"command": " ".join(["capt", *sys.argv[1:]]), "machine": machine_info(), **payload}
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    with os.fdopen(fd, "w") as fh:
+        json.dump(data, fh, indent=2, default=float)
+        fh.write("\n")
+    os.replace(tmp, path)
+    print(f"wrote {path}")

@@ -1,0 +1,114 @@
+"""Typed configuration of the opening tasks (object choice, placement, cameras, success), YAML-loadable."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from perception.yaml_config import ConfigError, require
+
+Split = Literal["train", "val", "test", "all"]
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    """One depth camera looking at the object.
+
+    The camera always looks at the object's bounding-box centre. By default its eye is ``eye``
+    (metres, world axes, relative to that centre) plus a uniform offset of up to ``jitter`` metres on
+    each axis per episode. With ``random_view`` the eye is instead drawn per episode on a sphere about
+    the centre: ``distance`` metres, ``azimuth`` radians measured from the object's front direction
+    (0 = straight in front, positive = counter-clockwise seen from above) and ``elevation`` radians
+    above the horizontal. ``fov`` is the vertical field of view in radians.
+    """
+
+    name: str = "depth_camera"
+    eye: tuple[float, float, float] = (-0.45, -0.35, 0.45)
+    width: int = 128
+    height: int = 128
+    fov: float = 1.0
+    near: float = 0.05
+    far: float = 4.0
+    jitter: float = 0.0
+    random_view: bool = False
+    distance: tuple[float, float] = (0.6, 0.9)
+    azimuth: tuple[float, float] = (-1.1, 1.1)
+    elevation: tuple[float, float] = (0.3, 0.9)
+
+    def validate(self) -> None:
+        require(self.width >= 8 and self.height >= 8, f"camera {self.name}: width/height must be >= 8")
+        require(0.05 < self.fov < 3.0, f"camera {self.name}: fov must be in (0.05, 3.0) radians")
+        require(0 < self.near < self.far, f"camera {self.name}: need 0 < near < far")
+        require(self.jitter >= 0, f"camera {self.name}: jitter must be >= 0")
+        for key in ("distance", "azimuth", "elevation"):
+            lo, hi = getattr(self, key)
+            require(lo <= hi, f"camera {self.name}: {key} must be (low, high) with low <= high")
+        require(self.distance[0] > self.near, f"camera {self.name}: distance must exceed near")
+        require(-1.5 < self.elevation[0] and self.elevation[1] < 1.5,
+                f"camera {self.name}: elevation must lie in (-1.5, 1.5) radians")
+
+
+@dataclass(frozen=True)
+class TaskConfig:
+    """What the opening task builds and how it randomises each episode.
+
+    Object: a procedural ``category`` (with instances drawn from ``split`` or from ``instance_ids``)
+    or a URDF/MJCF file ``object`` (then ``joint`` names the joint to open; default the first
+    movable one, and ``scale`` scales it). Exactly one of ``category``/``object`` is set.
+
+    Placement (world frame, metres/radians): the object's base centre is put at
+    ``object_xy`` +- ``object_xy_noise`` on the table top, its front facing the robot, turned by a
+    yaw uniform in +-``yaw_noise``.
+
+    Joint states at reset: the target joint starts at a fraction of its range uniform in
+    ``target_init_fraction``; other joints uniform in ``other_init_fraction`` of their ranges.
+
+    Success: the target joint is opened past ``success_fraction`` of its range and at rest
+    (child link speed below ``rest_linear_speed`` m/s and ``rest_angular_speed`` rad/s).
+    """
+
+    category: str | None = None
+    object: str | None = None
+    joint: str | None = None
+    scale: float = 1.0
+    split: Split = "train"
+    instance_ids: tuple[int, ...] | None = None
+    object_xy: tuple[float, float] = (0.12, 0.0)
+    object_xy_noise: tuple[float, float] = (0.05, 0.05)
+    yaw_noise: float = 0.2
+    target_init_fraction: tuple[float, float] = (0.0, 0.05)
+    other_init_fraction: tuple[float, float] = (0.0, 1.0)
+    success_fraction: float = 0.75
+    rest_linear_speed: float = 0.1
+    rest_angular_speed: float = 1.0
+    cameras: tuple[CameraConfig, ...] = field(default_factory=lambda: (CameraConfig(),))
+
+    def validate(self) -> None:
+        require(
+            (self.category is None) != (self.object is None),
+            "exactly one of 'category' and 'object' must be set",
+        )
+        if self.category is not None:
+            from capt_env.objects.registry import CATEGORIES
+
+            require(
+                self.category in CATEGORIES,
+                f"unknown category {self.category!r}; known: {list(CATEGORIES)}",
+            )
+        if self.joint is not None and self.object is None:
+            raise ConfigError("'joint' selects a joint of a user 'object' file; it needs 'object'")
+        require(self.scale > 0, f"scale must be > 0, got {self.scale}")
+        for name in ("target_init_fraction", "other_init_fraction"):
+            lo, hi = getattr(self, name)
+            require(0.0 <= lo <= hi <= 1.0, f"{name} must satisfy 0 <= low <= high <= 1, got {(lo, hi)}")
+        require(0.0 < self.success_fraction <= 1.0, "success_fraction must be in (0, 1]")
+        require(self.yaw_noise >= 0, "yaw_noise must be >= 0")
+        require(all(n >= 0 for n in self.object_xy_noise), "object_xy_noise must be >= 0")
+        require(len(self.cameras) >= 1, "at least one camera is needed")
+        names = [c.name for c in self.cameras]
+        require(len(set(names)) == len(names), f"camera names must be unique, got {names}")
+        for cam in self.cameras:
+            cam.validate()
+        if self.instance_ids is not None:
+            require(len(self.instance_ids) > 0, "instance_ids must not be empty")
+            require(all(i >= 0 for i in self.instance_ids), "instance_ids must be >= 0")

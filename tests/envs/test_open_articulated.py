@@ -1,0 +1,208 @@
+"""The opening task: Gymnasium compliance, determinism, physics-checked ground truth, bad inputs."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+from gymnasium.utils.env_checker import check_env
+
+import capt_env  # noqa: F401 - registers the env ids
+from capt_env.objects.registry import CATEGORIES
+from capt_env.registration import GENERIC_ID, env_id
+from perception.yaml_config import ConfigError
+
+CAMERA = {"name": "depth_camera", "eye": [-0.45, -0.3, 0.45], "width": 96, "height": 96}
+
+
+def make(category: str, **kwargs) -> gym.Env:
+    task = {"cameras": [CAMERA], "split": "test", **kwargs.pop("task", {})}
+    return gym.make(env_id(category), obs_mode=kwargs.pop("obs_mode", "pointcloud"), task=task, **kwargs)
+
+
+def rotate_about_line(points: np.ndarray, axis: np.ndarray, pivot: np.ndarray, angle: float) -> np.ndarray:
+    """Rodrigues rotation of (N, 3) points about the line (axis, pivot) by ``angle`` radians."""
+    k = axis / np.linalg.norm(axis)
+    v = points - pivot
+    cos, sin = np.cos(angle), np.sin(angle)
+    rotated = v * cos + np.cross(k, v) * sin + np.outer(v @ k, k) * (1 - cos)
+    return rotated + pivot
+
+
+def nearest_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """For each point of ``a``, the distance to the nearest point of ``b`` (metres)."""
+    d = torch.cdist(torch.as_tensor(a), torch.as_tensor(b))
+    return d.min(dim=1).values.numpy()
+
+
+@pytest.mark.parametrize("category", CATEGORIES)
+def test_env_checker_pointcloud(category: str) -> None:
+    env = make(category)
+    try:
+        check_env(env, skip_render_check=True)
+        obs, info = env.reset(seed=3)
+        pc = obs["pointcloud"]
+        assert pc["xyzw"].shape[0] == CAMERA["width"] * CAMERA["height"]
+        assert pc["part_label"].shape == (pc["xyzw"].shape[0],)
+        assert (pc["part_label"] >= 0).sum() > 200, "the camera must see the object"
+        assert info["joint_axis"].shape[-1] == 3
+        np.testing.assert_allclose(np.linalg.norm(info["joint_axis"], axis=-1), 1.0, atol=1e-5)
+    finally:
+        env.close()
+
+
+def test_same_seed_same_object_and_cloud() -> None:
+    clouds = []
+    for _ in range(2):
+        env = make("laptop")
+        obs, info = env.reset(seed=11)
+        clouds.append((obs["pointcloud"]["xyzw"].copy(), env.unwrapped.object.instance_id))
+        env.close()
+    assert clouds[0][1] == clouds[1][1]
+    np.testing.assert_allclose(clouds[0][0], clouds[1][0], atol=1e-6)
+
+
+def _child_points(env: gym.Env, child: int) -> np.ndarray:
+    obs = env.unwrapped.get_obs()
+    pc = obs["pointcloud"]
+    labels = pc["part_label"][0].cpu().numpy()
+    xyz = pc["xyzw"][0, :, :3].cpu().numpy()
+    return xyz[labels == child].astype(np.float64)
+
+
+@pytest.mark.parametrize("category", CATEGORIES)
+def test_physics_checked_labels(category: str) -> None:
+    """Move the target joint in the simulator; the child part's points must move as the GT axis says."""
+    env = make(category, task={"target_init_fraction": [0.25, 0.25], "other_init_fraction": [0.5, 0.5]})
+    try:
+        _, info = env.reset(seed=5)
+        base = env.unwrapped
+        k = int(info["target_joint"])
+        child = int(info["joint_child_part"][k])
+        jtype = int(info["joint_type"][k])
+        axis, pivot = info["joint_axis"][k].astype(np.float64), info["joint_pivot"][k].astype(np.float64)
+        lo, hi = info["joint_limits"][k]
+        delta = 0.25 * (hi - lo) if jtype == 1 else min(0.35, 0.25 * (hi - lo))
+        before = _child_points(env, child)
+        qpos = base.articulation.qpos.clone()
+        qpos[0, k] += delta
+        base.articulation.set_qpos(qpos)
+        after = _child_points(env, child)
+        moved_state = float(base.articulation.qpos[0, k])
+        assert moved_state == pytest.approx(float(info["joint_state"][k]) + delta, abs=1e-4)
+        assert len(before) > 50 and len(after) > 50
+
+        if jtype == 0:
+            predicted = rotate_about_line(before, axis, pivot, delta)
+            wrong = rotate_about_line(before, axis, pivot, -delta)
+        else:
+            predicted = before + delta * axis
+            wrong = before - delta * axis
+        good = np.median(nearest_distance(predicted, after))
+        bad = np.median(nearest_distance(wrong, after))
+        assert good < 0.006, f"{category}: points moved {good * 1000:.1f} mm away from the GT motion"
+        assert bad > 3 * good, f"{category}: the check cannot tell the axis sign ({good=}, {bad=})"
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("category", ["oven", "drawer_cabinet"])
+def test_part_labels_agree_with_simulator_segmentation(category: str) -> None:
+    env = make(category)
+    try:
+        obs, _ = env.reset(seed=2)
+        base = env.unwrapped
+        seg = obs["pointcloud"]["segmentation"][:, 0]
+        labels = obs["pointcloud"]["part_label"]
+        links = list(base.articulation.links)
+        id_map = base.segmentation_id_map
+        for seg_id in np.unique(seg):
+            entity = id_map.get(int(seg_id))
+            got = np.unique(labels[seg == seg_id])
+            assert len(got) == 1
+            if entity is not None and any(entity is link for link in links):
+                assert links[int(got[0])].name == entity.name
+            else:
+                assert got[0] == -1
+    finally:
+        env.close()
+
+
+def test_state_mode_steps_and_rewards() -> None:
+    env = make("drawer_cabinet", obs_mode="state")
+    try:
+        obs, info = env.reset(seed=0)
+        assert obs.ndim == 1 and np.all(np.isfinite(obs))
+        for _ in range(3):
+            obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+            assert 0.0 <= float(reward) <= 5.0
+        assert 0.0 <= float(info["open_fraction"]) < 0.75
+        assert not bool(info["success"])
+    finally:
+        env.close()
+
+
+def test_success_when_opened_and_at_rest() -> None:
+    env = make("cabinet_door", obs_mode="state")
+    try:
+        _, info = env.reset(seed=1)
+        base = env.unwrapped
+        k = int(info["target_joint"])
+        lo, hi = info["joint_limits"][k]
+        qpos = base.articulation.qpos.clone()
+        qpos[0, k] = lo + 0.9 * (hi - lo)
+        base.articulation.set_qpos(qpos)
+        ev = base.evaluate()
+        assert bool(ev["opened"][0]) and bool(ev["success"][0])
+        assert float(ev["open_fraction"][0]) == pytest.approx(0.9, abs=1e-3)
+    finally:
+        env.close()
+
+
+def test_generic_id_takes_category() -> None:
+    env = gym.make(GENERIC_ID, obs_mode="state", task={"category": "oven", "cameras": [CAMERA]})
+    try:
+        env.reset(seed=0)
+        assert env.unwrapped.object.category == "oven"
+    finally:
+        env.close()
+
+
+def test_bad_inputs_give_clear_errors(tmp_path) -> None:
+    with pytest.raises(ConfigError, match="unknown category"):
+        gym.make(GENERIC_ID, task={"category": "toaster"})
+    with pytest.raises(ConfigError, match="exactly one"):
+        gym.make(GENERIC_ID, task={})
+    with pytest.raises(ConfigError, match="target_init_fraction"):
+        make("laptop", task={"target_init_fraction": [0.5, 1.5]})
+    with pytest.raises(ConfigError, match="unknown key"):
+        make("laptop", task={"colour": "red"})
+    with pytest.raises(FileNotFoundError, match="missing.urdf"):
+        gym.make(GENERIC_ID, task={"object": str(tmp_path / "missing.urdf")})
+    with pytest.raises(ValueError, match="instance_id"):
+        env = make("laptop")
+        try:
+            env.reset(seed=0, options={"reconfigure": True, "instance_id": 10**6})
+        finally:
+            env.close()
+
+
+def test_user_urdf_object_with_named_joint(tmp_path) -> None:
+    from capt_env.objects.registry import make_object
+    from capt_env.objects.user_files import spec_to_urdf
+
+    spec = make_object("cabinet_door", 3)
+    path = tmp_path / "door.urdf"
+    path.write_text(spec_to_urdf(spec))
+    env = gym.make(GENERIC_ID, obs_mode="state", task={"object": str(path), "joint": spec.target_joint})
+    try:
+        _, info = env.reset(seed=0)
+        obj = env.unwrapped.object
+        assert obj.category == "user"
+        assert obj.joint_names[obj.target_joint].endswith(spec.target_joint)
+        np.testing.assert_allclose(np.linalg.norm(info["joint_axis"], axis=-1), 1.0, atol=1e-5)
+    finally:
+        env.close()
+    with pytest.raises(ValueError, match="no_such_joint"):
+        gym.make(GENERIC_ID, obs_mode="state", task={"object": str(path), "joint": "no_such_joint"})
