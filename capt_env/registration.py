@@ -17,6 +17,7 @@ from __future__ import annotations
 from typing import Any
 
 import gymnasium as gym
+import numpy as np
 
 MAX_EPISODE_STEPS = 200
 
@@ -42,6 +43,30 @@ def env_id(category: str, maniskill: bool = False) -> str:
     return f"CaptOpen{CATEGORY_ENV_NAMES[category]}-{'ms-' if maniskill else ''}v0"
 
 
+class OwnedArrays(gym.Wrapper):
+    """Copy observations and infos so each call returns arrays the caller owns.
+
+    ManiSkill's numpy views share memory with simulator buffers that the next step overwrites;
+    Gymnasium requires fresh data per call (and users keep what they are given).
+    """
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict]:
+        obs, info = self.env.reset(**kwargs)
+        return _copy_tree(obs), _copy_tree(info)
+
+    def step(self, action: Any) -> tuple[Any, Any, Any, Any, dict]:
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        return _copy_tree(obs), float(reward), bool(terminated), bool(truncated), _copy_tree(info)
+
+
+def _copy_tree(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {k: _copy_tree(v) for k, v in x.items()}
+    if isinstance(x, np.ndarray):
+        return x.copy()
+    return x
+
+
 def make_single_env(maniskill_id: str, **kwargs: Any) -> gym.Env:
     """Create a ManiSkill id with one CPU env and unbatch it to plain numpy (``CPUGymWrapper``)."""
     from mani_skill.utils.wrappers.gymnasium import CPUGymWrapper
@@ -50,7 +75,7 @@ def make_single_env(maniskill_id: str, **kwargs: Any) -> gym.Env:
         raise ValueError("the single-env ids take num_envs=1; use the '-ms-' ids for batched envs")
     kwargs.pop("num_envs", None)
     env = gym.make(maniskill_id, num_envs=1, **kwargs)
-    return CPUGymWrapper(env)
+    return OwnedArrays(CPUGymWrapper(env))
 
 
 def register_envs() -> None:

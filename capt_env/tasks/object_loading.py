@@ -197,11 +197,19 @@ def _far_point_on_link(link: Link, joint: ArticulationJoint, type_id: int) -> np
 
 
 def _front_yaw(aabb: tuple[np.ndarray, np.ndarray], grasp_link: Link, grasp_local: np.ndarray) -> float:
-    """Yaw turning the object-frame direction from its centre to the grasp point towards -x."""
+    """Yaw turning the object's front face towards -x (the robot).
+
+    The front is the side of the bounding box the grasp point lies on: the direction from the box
+    centre to the grasp point (in units of the box's half extents), snapped to the nearest of the object frame's +-x / +-y axes (objects
+    stand upright, so their faces are axis-aligned).
+    """
     mat = grasp_link.pose.to_transformation_matrix()[0].cpu().numpy()
     grasp = mat[:3, :3] @ grasp_local + mat[:3, 3]
     centre = (aabb[0] + aabb[1]) / 2
-    v = grasp[:2] - centre[:2]
+    half = np.maximum((aabb[1][:2] - aabb[0][:2]) / 2, 1e-6)
+    v = (grasp[:2] - centre[:2]) / half  # in box-relative units, so a wide box's front still wins
     if np.linalg.norm(v) < 1e-6:
         return 0.0
-    return float(math.pi - math.atan2(v[1], v[0]))
+    angle = math.atan2(v[1], v[0])
+    snapped = round(angle / (math.pi / 2)) * (math.pi / 2)
+    return float(math.pi - snapped)

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 import sapien
 import torch
+from gymnasium.utils import seeding as gym_seeding
 from mani_skill.agents.robots import Panda
 from mani_skill.envs.sapien_env import BaseEnv
 from mani_skill.sensors.camera import CameraConfig as MSCameraConfig
@@ -109,6 +110,13 @@ class OpenArticulatedEnv(BaseEnv):
                 num_envs=num_envs,
                 **kwargs,
             )
+
+    def reset(self, seed: int | list[int] | None = None, options: dict | None = None) -> tuple[Any, dict]:
+        if seed is not None:
+            # Gymnasium's own generator (env.np_random), seeded like ManiSkill's episode RNGs.
+            first = int(seed[0]) if isinstance(seed, (list, tuple, np.ndarray)) else int(seed)
+            self._np_random, self._np_random_seed = gym_seeding.np_random(first)
+        return super().reset(seed=seed, options=options)
 
     # ------------------------------------------------------------------ scene
     @property
@@ -269,6 +277,9 @@ class OpenArticulatedEnv(BaseEnv):
         if self.obs_mode == "pointcloud" and isinstance(obs, dict) and "pointcloud" in obs:
             seg = obs["pointcloud"]["segmentation"][..., 0].long()
             obs["pointcloud"]["part_label"] = self.part_labels_from_segmentation(seg)
+        if isinstance(obs, dict):
+            # ManiSkill leaves an empty "sensor_data" dict in pointcloud mode; Gymnasium forbids empty Dicts.
+            obs = {k: v for k, v in obs.items() if not (isinstance(v, dict) and len(v) == 0)}
         return obs
 
     def part_labels_from_segmentation(self, seg: torch.Tensor) -> torch.Tensor:
