@@ -1,0 +1,40 @@
+"""The ``capt`` command line: every verb is wired, doctor reports the renderer, bench writes JSON."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from capt_env.cli import VERBS, build_parser, main
+
+
+def test_every_verb_has_help(capsys: pytest.CaptureFixture[str]) -> None:
+    for verb in VERBS:
+        with pytest.raises(SystemExit) as exc:
+            main([verb, "--help"])
+        assert exc.value.code == 0
+        assert "--json" in capsys.readouterr().out
+
+
+def test_unknown_verb_fails() -> None:
+    with pytest.raises(SystemExit) as exc:
+        build_parser().parse_args(["fly"])
+    assert exc.value.code == 2
+
+
+def test_doctor_reports_a_working_renderer(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "doctor.json"
+    assert main(["doctor", "--json", str(out)]) == 0
+    assert "rendering: OK" in capsys.readouterr().out
+    data = json.loads(out.read_text())
+    assert data["rendering_ok"] is True and data["versions"]["sapien"] == "3.0.3"
+
+
+def test_bench_writes_numbers(tmp_path: Path) -> None:
+    out = tmp_path / "bench.json"
+    assert main(["bench", "--category", "drawer_cabinet", "--steps", "5", "--resets", "1",
+                 "--obs-modes", "state", "--json", str(out)]) == 0
+    result = json.loads(out.read_text())["results"][0]
+    assert result["obs_mode"] == "state" and result["steps_per_second"] > 0

@@ -1,0 +1,73 @@
+"""The strict YAML -> dataclass loader: unknown keys and bad values are errors that name them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import pytest
+
+from perception.yaml_config import ConfigError, from_dict, load_yaml, require, to_dict
+
+
+@dataclass(frozen=True)
+class Inner:
+    size: int = 3
+    ratio: tuple[float, float] = (0.1, 0.2)
+
+
+@dataclass(frozen=True)
+class Outer:
+    name: str = "x"
+    mode: Literal["a", "b"] = "a"
+    inner: Inner = field(default_factory=Inner)
+    items: tuple[Inner, ...] = ()
+    maybe: float | None = None
+
+    def validate(self) -> None:
+        require(self.inner.size > 0, "inner.size must be > 0")
+
+
+def test_defaults_and_nested_values() -> None:
+    cfg = from_dict(Outer, {"mode": "b", "inner": {"ratio": [1, 2]}, "items": [{"size": 5}], "maybe": 2})
+    assert cfg.mode == "b" and cfg.inner == Inner(3, (1.0, 2.0)) and cfg.items == (Inner(5),)
+    assert cfg.maybe == 2.0 and isinstance(cfg.maybe, float)
+    assert from_dict(Outer, to_dict(cfg)) == cfg
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        ({"colour": 1}, r"unknown key\(s\) \['colour'\]"),
+        ({"inner": {"sise": 1}}, r"config.inner: unknown key"),
+        ({"mode": "c"}, r"config.mode: 'c' is not one of"),
+        ({"inner": {"size": "3"}}, r"config.inner.size: expected an integer"),
+        ({"inner": {"size": True}}, r"config.inner.size: expected an integer"),
+        ({"inner": {"ratio": [1]}}, r"config.inner.ratio: expected 2 items"),
+        ({"inner": {"size": 0}}, r"inner.size must be > 0"),
+        ([1, 2], r"expected a mapping"),
+    ],
+)
+def test_errors_name_the_key(data: object, message: str) -> None:
+    with pytest.raises(ConfigError, match=message):
+        from_dict(Outer, data)
+
+
+def test_load_yaml_file(tmp_path: Path) -> None:
+    path = tmp_path / "c.yaml"
+    path.write_text("name: y\ninner:\n  size: 7\n")
+    assert load_yaml(Outer, path).inner.size == 7
+    with pytest.raises(ConfigError, match="not found"):
+        load_yaml(Outer, tmp_path / "missing.yaml")
+
+
+def test_shipped_configs_load() -> None:
+    from capt_env.dataset.config import GenerateConfig
+    from capt_env.tasks.config import TaskConfig
+
+    root = Path(__file__).resolve().parents[1] / "configs"
+    for path in sorted((root / "generate").glob("*.yaml")):
+        assert load_yaml(GenerateConfig, path).category == path.stem
+    for path in sorted((root / "tasks").glob("*.yaml")):
+        load_yaml(TaskConfig, path)
