@@ -13,7 +13,6 @@ import sys
 # verb -> (module under capt_env.commands, one-line help)
 VERBS: dict[str, tuple[str, str]] = {
     "doctor": ("doctor", "rendering device SAPIEN sees, versions, and what to install"),
-    "demo": ("demo", "the main job: render unseen objects, estimate and open them, save pictures"),
     "generate": ("generate", "render a labelled point-cloud dataset of one category as shards"),
     "bench": ("bench", "environment speed: steps/s in state and pointcloud mode, reset time"),
 }

@@ -1,4 +1,4 @@
-"""Figures for the paper's qualitative results: a cloud coloured by part, predicted axes in red, true in green."""
+"""Figures for the paper's qualitative results: cloud coloured by part, predicted axes red, true green."""
 
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ def plot_cloud_with_axes(
             d = d / (np.linalg.norm(d) or 1.0)
             p = np.asarray(pivot, dtype=np.float64)
             a, b = p - 0.5 * length * d, p + 0.5 * length * d
-            ax.plot(*zip(a, b), color=colour, linewidth=2.5)
+            ax.plot(*zip(a, b, strict=True), color=colour, linewidth=2.5)
             ax.quiver(*b, *(0.15 * length * d), color=colour, linewidth=2.5)
     centre = (points.max(0) + points.min(0)) / 2
     half = 0.6 * length

@@ -51,7 +51,8 @@ def _convert(value: Any, tp: Any, where: str) -> Any:
         if origin is tuple and args and args[-1] is not Ellipsis:
             if len(value) != len(args):
                 raise ConfigError(f"{where}: expected {len(args)} items, got {len(value)}")
-            items = [_convert(v, a, f"{where}[{i}]") for i, (v, a) in enumerate(zip(value, args))]
+            pairs = enumerate(zip(value, args, strict=True))
+            items = [_convert(v, a, f"{where}[{i}]") for i, (v, a) in pairs]
         else:
             item_tp = args[0] if args else Any
             items = [_convert(v, item_tp, f"{where}[{i}]") for i, v in enumerate(value)]

@@ -12,9 +12,7 @@ import numpy as np
 
 from capt_env.objects.spec import Box
 
-_CORNER_SIGNS = np.array(
-    [[sx, sy, sz] for sx in (-1.0, 1.0) for sy in (-1.0, 1.0) for sz in (-1.0, 1.0)]
-)
+_CORNER_SIGNS = np.array([[sx, sy, sz] for sx in (-1.0, 1.0) for sy in (-1.0, 1.0) for sz in (-1.0, 1.0)])
 
 
 def quat_to_matrix(quat: Sequence[float]) -> np.ndarray:
@@ -91,4 +89,4 @@ def opening_axis(lever: Sequence[float], direction: Sequence[float]) -> tuple[fl
     norm = np.linalg.norm(axis)
     if norm < 1e-12:
         raise ValueError("lever and direction must not be parallel")
-    return tuple(float(v) for v in axis / norm)
+    return tuple(float(v) + 0.0 for v in axis / norm)  # + 0.0 turns -0.0 into 0.0

@@ -32,8 +32,9 @@ def box_from_bounds(lo: Sequence[float], hi: Sequence[float], color: RGBA, is_ha
     )
 
 
-def open_carcass(width: float, depth: float, height: float, wall: float, color: RGBA,
-                 z0: float = 0.0) -> list[Box]:
+def open_carcass(
+    width: float, depth: float, height: float, wall: float, color: RGBA, z0: float = 0.0
+) -> list[Box]:
     """Five panels (bottom, top, left, right, back) of a box body open at its front (-x).
 
     The body spans x in [-depth/2, depth/2], y in [-width/2, width/2], z in [z0, z0 + height].
@@ -50,9 +51,16 @@ def open_carcass(width: float, depth: float, height: float, wall: float, color: 
     ]
 
 
-def bar_handle(surface_point: Sequence[float], normal: int, normal_sign: float, along: int,
-               length: float, thickness: float, standoff: float, color: RGBA = HANDLE_COLOR
-               ) -> tuple[list[Box], tuple[float, float, float]]:
+def bar_handle(
+    surface_point: Sequence[float],
+    normal: int,
+    normal_sign: float,
+    along: int,
+    length: float,
+    thickness: float,
+    standoff: float,
+    color: RGBA = HANDLE_COLOR,
+) -> tuple[list[Box], tuple[float, float, float]]:
     """A bar handle on two posts: the bar runs along axis ``along``; it stands ``standoff`` metres
     off the surface (gap between surface and bar) in direction ``normal_sign`` * e_``normal``.
 
@@ -66,22 +74,38 @@ def bar_handle(surface_point: Sequence[float], normal: int, normal_sign: float, 
     centre = p + e_n * (standoff + thickness / 2)
     half = np.full(3, thickness / 2)
     half[along] = length / 2
-    bar = Box(half_size=tuple(float(v) for v in half), pos=tuple(float(v) for v in centre),
-              color=color, is_handle=True)
+    bar = Box(
+        half_size=tuple(float(v) for v in half),
+        pos=tuple(float(v) for v in centre),
+        color=color,
+        is_handle=True,
+    )
     post = 0.8 * thickness
     boxes = [bar]
     for side in (-1.0, 1.0):
         post_centre = p + e_n * (standoff / 2) + np.eye(3)[along] * side * (length / 2 - post / 2)
         post_half = np.full(3, post / 2)
         post_half[normal] = standoff / 2 + 1e-4  # reach just into the surface and the bar
-        boxes.append(Box(half_size=tuple(float(v) for v in post_half),
-                         pos=tuple(float(v) for v in post_centre), color=color, is_handle=True))
+        boxes.append(
+            Box(
+                half_size=tuple(float(v) for v in post_half),
+                pos=tuple(float(v) for v in post_centre),
+                color=color,
+                is_handle=True,
+            )
+        )
     return boxes, tuple(float(v) for v in centre)
 
 
-def knob_handle(surface_point: Sequence[float], normal: int, normal_sign: float, cap_size: float,
-                cap_depth: float, standoff: float, color: RGBA = HANDLE_COLOR
-                ) -> tuple[list[Box], tuple[float, float, float]]:
+def knob_handle(
+    surface_point: Sequence[float],
+    normal: int,
+    normal_sign: float,
+    cap_size: float,
+    cap_depth: float,
+    standoff: float,
+    color: RGBA = HANDLE_COLOR,
+) -> tuple[list[Box], tuple[float, float, float]]:
     """A knob-like handle: a thin stem of length ``standoff`` and a square cap (``cap_size`` across,
     ``cap_depth`` thick along the normal) at its end. Returns the boxes and the cap centre."""
     p = np.asarray(surface_point, dtype=np.float64)
@@ -93,9 +117,24 @@ def knob_handle(surface_point: Sequence[float], normal: int, normal_sign: float,
     stem_half[normal] = standoff / 2 + 1e-4
     stem_centre = p + e_n * (standoff / 2)
     boxes = [
-        Box(half_size=tuple(float(v) for v in cap_half), pos=tuple(float(v) for v in cap_centre),
-            color=color, is_handle=True),
-        Box(half_size=tuple(float(v) for v in stem_half), pos=tuple(float(v) for v in stem_centre),
-            color=color, is_handle=True),
+        Box(
+            half_size=tuple(float(v) for v in cap_half),
+            pos=tuple(float(v) for v in cap_centre),
+            color=color,
+            is_handle=True,
+        ),
+        Box(
+            half_size=tuple(float(v) for v in stem_half),
+            pos=tuple(float(v) for v in stem_centre),
+            color=color,
+            is_handle=True,
+        ),
     ]
     return boxes, tuple(float(v) for v in cap_centre)
+
+
+BODY_WHITES = ((0.92, 0.92, 0.9), (0.85, 0.86, 0.88), (0.8, 0.8, 0.78))
+METALS = ((0.6, 0.62, 0.65), (0.3, 0.3, 0.32), (0.12, 0.12, 0.13), (0.72, 0.72, 0.74))
+WOODS = ((0.55, 0.38, 0.22), (0.72, 0.55, 0.36), (0.4, 0.26, 0.15), (0.9, 0.88, 0.82))
+GLASS = ((0.08, 0.1, 0.14), (0.15, 0.18, 0.25))
+FRAMES = ((0.05, 0.05, 0.05), (0.35, 0.2, 0.1), (0.55, 0.55, 0.6), (0.6, 0.1, 0.1), (0.1, 0.15, 0.4))

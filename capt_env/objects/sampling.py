@@ -62,8 +62,9 @@ class ParamSampler:
         self.params[name] = value
         return value
 
-    def color(self, name: str, palette: Sequence[tuple[float, float, float]], jitter: float = 0.05
-              ) -> tuple[float, float, float, float]:
+    def color(
+        self, name: str, palette: Sequence[tuple[float, float, float]], jitter: float = 0.05
+    ) -> tuple[float, float, float, float]:
         """An RGBA colour near one of ``palette``'s RGB entries, recorded under ``name``."""
         base = np.asarray(palette[int(self.rng.integers(len(palette)))], dtype=np.float64)
         rgb = np.clip(base + self.rng.uniform(-jitter, jitter, size=3), 0.0, 1.0)

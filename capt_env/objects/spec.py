@@ -73,6 +73,9 @@ class ObjectSpec:
     grasp_link: str
     grasp_point: tuple[float, float, float]
     params: dict = field(default_factory=dict, compare=False)  # the sampled shape parameters
+    # outward normal of the object's front (the side a robot should stand at), object frame; every
+    # procedural category faces -x
+    front: tuple[float, float, float] = (-1.0, 0.0, 0.0)
 
     def link_index(self, name: str) -> int:
         for i, link in enumerate(self.links):

@@ -17,7 +17,7 @@ _VAL_END = 900
 
 
 def split_of(category: str, instance_id: int) -> str:
-    """"train", "val" or "test" for one instance (about 70 / 20 / 10 % of the ids)."""
+    """ "train", "val" or "test" for one instance (about 70 / 20 / 10 % of the ids)."""
     check_instance_id(category, instance_id)
     bucket = zlib.crc32(f"capt-split/{category}/{int(instance_id)}".encode()) % _BUCKETS
     if bucket < _TRAIN_END:

@@ -106,7 +106,7 @@ def load_object(
     link_names = [link.name for link in links]
     child_parts = [link_names.index(j.child_link.name) for j in joints]
     type_ids = [_joint_type_id(j) for j in joints]
-    limits = np.array([_limits(j, t) for j, t in zip(joints, type_ids)], dtype=np.float64)
+    limits = np.array([_limits(j, t) for j, t in zip(joints, type_ids, strict=True)], dtype=np.float64)
 
     if grasp_link_name is None:
         grasp_link = joints[target].child_link
@@ -114,7 +114,10 @@ def load_object(
     else:
         grasp_link = links[link_names.index(grasp_link_name)]
 
-    front_yaw = _front_yaw(aabb, grasp_link, grasp_local)
+    if spec is not None:  # procedural objects state their front's outward normal (object frame)
+        front_yaw = float(math.pi - math.atan2(spec.front[1], spec.front[0]))
+    else:
+        front_yaw = _front_yaw(aabb, grasp_link, grasp_local)
     return LoadedObject(
         articulation=art, name="object", category=category, instance_id=iid, spec=spec,
         joints=joints, joint_names=names, joint_type_ids=type_ids, limits=limits,
@@ -197,11 +200,11 @@ def _far_point_on_link(link: Link, joint: ArticulationJoint, type_id: int) -> np
 
 
 def _front_yaw(aabb: tuple[np.ndarray, np.ndarray], grasp_link: Link, grasp_local: np.ndarray) -> float:
-    """Yaw turning the object's front face towards -x (the robot).
+    """Yaw turning a user object's front face towards -x (the robot).
 
     The front is the side of the bounding box the grasp point lies on: the direction from the box
-    centre to the grasp point (in units of the box's half extents), snapped to the nearest of the object frame's +-x / +-y axes (objects
-    stand upright, so their faces are axis-aligned).
+    centre to the grasp point (in units of the box's half extents), snapped to the nearest of the
+    object frame's +-x / +-y axes (objects stand upright, so their faces are axis-aligned).
     """
     mat = grasp_link.pose.to_transformation_matrix()[0].cpu().numpy()
     grasp = mat[:3, :3] @ grasp_local + mat[:3, 3]

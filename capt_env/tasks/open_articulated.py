@@ -267,7 +267,7 @@ class OpenArticulatedEnv(BaseEnv):
             obs.update(
                 grasp_point=info["grasp_point"],
                 tcp_to_grasp=info["grasp_point"] - self.agent.tcp.pose.p,
-                target_qpos=self.articulation.qpos[:, self.object.target_joint : self.object.target_joint + 1],
+                target_qpos=self.articulation.qpos[:, [self.object.target_joint]],
                 open_fraction=info["open_fraction"].unsqueeze(-1),
             )
         return obs

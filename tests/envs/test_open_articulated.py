@@ -45,7 +45,7 @@ def test_env_checker_pointcloud(category: str) -> None:
         pc = obs["pointcloud"]
         assert pc["xyzw"].shape[0] == CAMERA["width"] * CAMERA["height"]
         assert pc["part_label"].shape == (pc["xyzw"].shape[0],)
-        assert (pc["part_label"] >= 0).sum() > 200, "the camera must see the object"
+        assert (pc["part_label"] >= 0).sum() > 100, "the camera must see the object"
         assert info["joint_axis"].shape[-1] == 3
         np.testing.assert_allclose(np.linalg.norm(info["joint_axis"], axis=-1), 1.0, atol=1e-5)
     finally:
@@ -128,7 +128,9 @@ def test_physics_checked_labels(category: str) -> None:
     when the boxes are placed by the GT motion, and at least 2x farther (mean) under a wrong hypothesis
     (flipped sign, axis tilted 10 deg, pivot shifted 2 cm).
     """
-    env = make(category, task={"target_init_fraction": [0.25, 0.25], "other_init_fraction": [0.5, 0.5]})
+    close_camera = {"name": "depth_camera", "eye": [-0.25, -0.25, 0.4], "width": 128, "height": 128}
+    task = {"target_init_fraction": [0.4, 0.4], "other_init_fraction": [0.5, 0.5], "cameras": [close_camera]}
+    env = make(category, task=task)
     try:
         _, info = env.reset(seed=5)
         base = env.unwrapped
@@ -137,7 +139,7 @@ def test_physics_checked_labels(category: str) -> None:
         jtype = int(info["joint_type"][k])
         axis, pivot = info["joint_axis"][k].astype(np.float64), info["joint_pivot"][k].astype(np.float64)
         lo, hi = (float(v) for v in info["joint_limits"][k])
-        delta = 0.25 * (hi - lo) if jtype == 1 else min(0.35, 0.25 * (hi - lo))
+        delta = 0.2 * (hi - lo) if jtype == 1 else min(0.35, 0.2 * (hi - lo))
         link = base.articulation.links[child]
         before = _child_points(env, child)
         pose_before = link.pose.to_transformation_matrix()[0].cpu().numpy().astype(np.float64)
@@ -146,7 +148,8 @@ def test_physics_checked_labels(category: str) -> None:
         base.articulation.set_qpos(qpos)
         after = _child_points(env, child)
         pose_after = link.pose.to_transformation_matrix()[0].cpu().numpy().astype(np.float64)
-        assert float(base.articulation.qpos[0, k]) == pytest.approx(float(info["joint_state"][k]) + delta, abs=1e-4)
+        expected_state = float(info["joint_state"][k]) + delta
+        assert float(base.articulation.qpos[0, k]) == pytest.approx(expected_state, abs=1e-4)
         assert len(before) > 50 and len(after) > 50, f"{category}: the camera must see the moving part"
 
         predicted = _moved(before, jtype, axis, pivot, delta)

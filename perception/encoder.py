@@ -1,0 +1,97 @@
+"""PCT encoder (paper Sec. III-A; Guo et al. 2021, "PCT: Point Cloud Transformer"), segmentation form.
+
+Input embedding (two point-wise LBR layers), neighbour embedding (kNN grouping as PCT's SG module but
+keeping all n points, so features stay per point), four offset-attention layers of width d_e whose
+outputs are concatenated to (B, n, 4*d_e), and a global feature (max and mean pool of a fused
+projection) that the heads may broadcast to every point, as PCT's segmentation head does.
+"""
+
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+
+def knn_indices(xyz: torch.Tensor, k: int) -> torch.Tensor:
+    """Indices (B, n, k) of each point's k nearest neighbours (itself included) in ``xyz`` (B, n, 3)."""
+    d2 = torch.cdist(xyz, xyz)
+    return d2.topk(k, dim=-1, largest=False).indices
+
+
+def gather_neighbours(feat: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
+    """Features (B, C, n) gathered at ``idx`` (B, n, k) -> (B, C, n, k)."""
+    b, c, n = feat.shape
+    k = idx.shape[-1]
+    flat = idx.reshape(b, 1, n * k).expand(b, c, n * k)
+    return feat.gather(2, flat).reshape(b, c, n, k)
+
+
+class NeighbourEmbedding(nn.Module):
+    """One SG-style layer without sampling: edge features (f_j - f_i, f_i) of the k neighbours -> LBR
+    -> max over the neighbourhood."""
+
+    def __init__(self, channels: int) -> None:
+        super().__init__()
+        self.mlp = nn.Sequential(
+            nn.Conv2d(2 * channels, channels, 1, bias=False), nn.BatchNorm2d(channels), nn.ReLU(inplace=True)
+        )
+
+    def forward(self, feat: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
+        neigh = gather_neighbours(feat, idx)
+        centre = feat.unsqueeze(-1).expand_as(neigh)
+        return self.mlp(torch.cat([neigh - centre, centre], dim=1)).amax(dim=-1)
+
+
+class OffsetAttention(nn.Module):
+    """PCT offset-attention: A = softmax(Q K^T) then L1-normalised over the other dim,
+    F_sa = V A, output = LBR(F_in - F_sa) + F_in. Query and key share weights, as in PCT."""
+
+    def __init__(self, channels: int) -> None:
+        super().__init__()
+        self.qk = nn.Conv1d(channels, channels // 4, 1, bias=False)
+        self.v = nn.Conv1d(channels, channels, 1)
+        self.trans = nn.Conv1d(channels, channels, 1)
+        self.norm = nn.BatchNorm1d(channels)
+        self.act = nn.ReLU(inplace=True)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        q = self.qk(x)  # (B, C/4, n)
+        energy = torch.bmm(q.transpose(1, 2), q)  # (B, n, n)
+        attn = torch.softmax(energy, dim=-1)
+        attn = attn / (1e-9 + attn.sum(dim=1, keepdim=True))
+        f_sa = torch.bmm(self.v(x), attn)  # (B, C, n)
+        return x + self.act(self.norm(self.trans(x - f_sa)))
+
+
+class PCTEncoder(nn.Module):
+    """Points (B, n, 3) -> per-point features (B, n, 4*d_e) and global feature (B, 2*4*d_e)."""
+
+    def __init__(self, embed_dim: int, knn_k: int, neighbor_layers: int = 1) -> None:
+        super().__init__()
+        d = embed_dim
+        self.knn_k = knn_k
+        self.input_embedding = nn.Sequential(
+            nn.Conv1d(3, d, 1, bias=False), nn.BatchNorm1d(d), nn.ReLU(inplace=True),
+            nn.Conv1d(d, d, 1, bias=False), nn.BatchNorm1d(d), nn.ReLU(inplace=True),
+        )
+        self.neighbour = nn.ModuleList(NeighbourEmbedding(d) for _ in range(neighbor_layers))
+        self.attention = nn.ModuleList(OffsetAttention(d) for _ in range(4))
+        self.fuse = nn.Sequential(nn.Conv1d(4 * d, 4 * d, 1, bias=False), nn.BatchNorm1d(4 * d),
+                                  nn.LeakyReLU(0.2, inplace=True))
+        self.point_dim = 4 * d
+        self.global_dim = 8 * d
+
+    def forward(self, xyz: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        x = self.input_embedding(xyz.transpose(1, 2))
+        if len(self.neighbour):
+            idx = knn_indices(xyz, min(self.knn_k, xyz.shape[1]))
+            for layer in self.neighbour:
+                x = layer(x, idx)
+        outs = []
+        for layer in self.attention:
+            x = layer(x)
+            outs.append(x)
+        per_point = torch.cat(outs, dim=1)  # (B, 4d, n)
+        fused = self.fuse(per_point)
+        global_feat = torch.cat([fused.amax(dim=-1), fused.mean(dim=-1)], dim=1)
+        return per_point.transpose(1, 2), global_feat

@@ -1,0 +1,78 @@
+"""Metrics against hand-computed values (paper Table I definitions)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from perception.metrics import (
+    JointResult,
+    SampleResult,
+    average_precision,
+    direction_error_deg,
+    line_distance,
+    mean_iou,
+    segmentation_accuracy,
+    state_error,
+    summarise,
+    table_markdown,
+)
+
+
+def test_direction_error_sign_convention():
+    assert direction_error_deg([1, 0, 0], [-1, 0, 0]) == pytest.approx(180.0)
+    assert direction_error_deg([0, 0, 2], [0, 0, 1]) == pytest.approx(0.0, abs=1e-9)
+    assert direction_error_deg([1, 0, 0], [0, 1, 0]) == pytest.approx(90.0)
+    assert direction_error_deg([1, 1, 0], [1, 0, 0]) == pytest.approx(45.0)
+
+
+def test_line_distance_cases():
+    assert line_distance([0, 0, 1], [0, 0, 0], [0, 0, 1], [0.03, 0.04, 9]) == pytest.approx(0.05)  # parallel
+    assert line_distance([1, 0, 0], [0, 0, 0], [0, 1, 0], [0, 0, 0.2]) == pytest.approx(0.2)  # skew
+    assert line_distance([1, 0, 0], [0, 0, 0], [0, 1, 1], [3, -1, -1]) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_segmentation_accuracy_and_miou_hand_example():
+    gt = np.array([0, 0, 0, 1, 1, 1, -1])
+    pred = np.array([0, 0, 1, 1, 1, 2, 0])
+    # valid points: 6; correct: 0,0,_,1,1,_ = 4
+    assert segmentation_accuracy(pred, gt) == pytest.approx(4 / 6)
+    # IoU0 = 2/3, IoU1 = 2/4, IoU2 = 0/1 (part only in the prediction)
+    assert mean_iou(pred, gt) == pytest.approx((2 / 3 + 0.5 + 0.0) / 3)
+
+
+def test_state_error_units():
+    assert state_error(math.radians(30), math.radians(20), "revolute") == pytest.approx(10.0)
+    assert state_error(0.12, 0.10, "prismatic") == pytest.approx(0.02)
+
+
+def test_average_precision_is_strictly_below():
+    errs = [1.0, 4.9, 5.0, 7.0, 12.0, float("nan")]
+    assert average_precision(errs, 5.0) == pytest.approx(2 / 5)
+    assert average_precision(errs, 10.0) == pytest.approx(4 / 5)
+    assert math.isnan(average_precision([], 5.0))
+
+
+def _result(dir_err, pos, state, method="capt", cat="laptop"):
+    return SampleResult(cat, method, 1.0, 1.0, (JointResult(0, "revolute", dir_err, pos, pos, state),), 10.0)
+
+
+def test_summarise_and_table():
+    rs = [_result(2.0, 0.005, 4.0), _result(8.0, 0.03, 20.0)]
+    s = summarise(rs)
+    assert s["dir_med"] == [pytest.approx(5.0)]
+    assert s["dir_ap5"] == [0.5] and s["dir_ap10"] == [1.0]
+    assert s["pos_aed"] == [pytest.approx(0.0175)]
+    assert s["pos_ap1"] == [0.5] and s["pos_ap5"] == [1.0]
+    assert s["state_ap5"] == [0.5] and s["state_ap10"] == [0.5]
+    prism = SampleResult("drawer", "capt", None, None, (JointResult(0, "prismatic", 1.0, None, None, 0.02),))
+    table = table_markdown([*rs, prism])
+    lines = table.splitlines()
+    assert lines[0].startswith("| Dataset | Method | PA | mIoU | Dir MED")
+    row = "| laptop | capt | 1.00 | 1.00 | 5.00 | 0.50 | 1.00 | 0.02 | 0.50 | 1.00 | 12.00 | 0.50 | 0.50 |"
+    assert row in table
+    drawer = next(line for line in lines if line.startswith("| drawer"))
+    assert "| - | - | 1.00 |" in drawer  # no segmentation; position '-' for prismatic
+    assert any(line.startswith("| Mean | capt") for line in lines)
