@@ -14,6 +14,8 @@ import sys
 VERBS: dict[str, tuple[str, str]] = {
     "doctor": ("doctor", "rendering device SAPIEN sees, versions, and what to install"),
     "generate": ("generate", "render a labelled point-cloud dataset of one category as shards"),
+    "train": ("train", "train a CAPT variant (capt, capt_plain, pct_regression) on a generated dataset"),
+    "evaluate": ("evaluate", "the paper's Table I and time per input for checkpoints, side by side"),
     "bench": ("bench", "environment speed: steps/s in state and pointcloud mode, reset time"),
 }
 

@@ -1,0 +1,70 @@
+"""``capt evaluate``: the paper's Table I (and Table II timing) for one or more checkpoints, side by side."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from capt_env.commands.json_output import write_json
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("checkpoints", nargs="+", help="checkpoints (e.g. CAPT, CAPT-plain, PCT) to compare")
+    parser.add_argument("--data", required=True, help="dataset directory made by `capt generate`")
+    parser.add_argument("--split", default="test", choices=["train", "val", "test"])
+    parser.add_argument("--device", default="cpu")
+    parser.add_argument("--timing-clouds", type=int, default=100, help="clouds timed per checkpoint")
+    parser.add_argument("--max-samples", type=int, default=None)
+    parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
+    parser.add_argument("--figures", default=None, help="save a cloud+axes PNG per checkpoint here")
+
+
+def run(args: argparse.Namespace) -> int:
+    import dataclasses
+
+    from perception.evaluation import evaluate
+    from perception.metrics import summarise
+
+    result = evaluate(args.checkpoints, args.data, split=args.split, device=args.device,
+                      timing_clouds=args.timing_clouds, max_samples=args.max_samples)
+    timing = "\n".join(f"| {m} | {ms:.1f} |" for m, ms in result.median_ms.items())
+    text = (f"{result.table}\n\nTime per input (median over >= {args.timing_clouds} clouds, "
+            f"device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")
+    print(text)
+    if args.markdown:
+        Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.markdown).write_text(text)
+    if args.figures:
+        _figures(args.checkpoints, args.data, args.split, Path(args.figures))
+    methods = sorted({r.method for r in result.results})
+    categories = sorted({r.category for r in result.results})
+    summary = {m: {c: summarise([r for r in result.results if r.method == m and r.category == c])
+                   for c in categories} for m in methods}
+    write_json(args.json, {
+        "split": args.split, "data": args.data, "checkpoints": args.checkpoints,
+        "median_ms_per_input": result.median_ms, "summary": summary, "table_markdown": result.table,
+        "samples": [dataclasses.asdict(r) for r in result.results],
+    })
+    return 0
+
+
+def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path) -> None:
+    """One picture per checkpoint: the first test cloud coloured by predicted part, axes red/green."""
+    import numpy as np
+
+    from perception.data import CaptShardDataset
+    from perception.figures import plot_cloud_with_axes
+    from perception.inference import ArticulationEstimator
+
+    for path in checkpoints:
+        est = ArticulationEstimator.from_checkpoint(path)
+        sample = CaptShardDataset(data, split, est.config.model, augment=False, max_samples=1).sample(0)
+        cloud = np.asarray(sample.points, np.float64)[np.asarray(sample.part_labels) >= 0]
+        pred = est.predict(cloud)
+        true = [(sample.joint_dirs[k], sample.joint_pivots[k]) for k in range(len(sample.joint_mask))
+                if sample.joint_mask[k]]
+        name = f"{sample.category}_{est.config.model.variant}.png"
+        plot_cloud_with_axes(out_dir / name, cloud, pred.part_labels,
+                             [(j.direction, j.pivot) for j in pred.joints], true,
+                             title=f"{sample.category}, {est.config.model.variant}")
+        print(f"wrote {out_dir / name}")

@@ -1,0 +1,57 @@
+"""``capt train``: train one CAPT variant on a generated dataset (see perception.training)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from capt_env.commands.json_output import write_json
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--config", default="configs/perception/capt.yaml", help="YAML TrainConfig")
+    parser.add_argument("--data", required=True, help="dataset directory made by `capt generate`")
+    parser.add_argument("--out", required=True, help="run directory: last.pt, best.pt, log.csv")
+    parser.add_argument("--epochs", type=int, default=None, help="override the config's epochs")
+    parser.add_argument("--device", default=None, help="auto, cpu or cuda[:i] (default: the config's)")
+    parser.add_argument("--stop-after", type=int, default=None,
+                        help="run at most this many epochs now; run again to resume")
+    parser.add_argument("--no-resume", action="store_true", help="start over even if last.pt exists")
+
+
+def train_config_for(config_path: str, data_dir: str, epochs: int | None, device: str | None):
+    """The YAML TrainConfig with the model's output channels set for the dataset's category."""
+
+    from capt_env.dataset.category_structure import category_structure
+    from perception.config import TrainConfig
+    from perception.yaml_config import from_dict, load_yaml, to_dict
+
+    manifest = Path(data_dir) / "manifest.json"
+    if not manifest.is_file():
+        raise SystemExit(f"{data_dir} has no manifest.json: make it with `capt generate`")
+    category = json.loads(manifest.read_text())["config"]["category"]
+    cfg = to_dict(load_yaml(TrainConfig, config_path))
+    cfg["model"]["model"].update(category_structure(category))
+    if epochs is not None:
+        cfg["epochs"] = epochs
+    if device is not None:
+        cfg["device"] = device
+    return from_dict(TrainConfig, cfg), category
+
+
+def run(args: argparse.Namespace) -> int:
+    from perception.training import train
+
+    cfg, category = train_config_for(args.config, args.data, args.epochs, args.device)
+    result = train(cfg, args.data, args.out, resume=not args.no_resume, stop_after=args.stop_after)
+    print(f"{category} {cfg.model.model.variant}: {result.epochs_run}/{cfg.epochs} epochs, "
+          f"best val loss {result.best_val_loss:.4f}, voting window {result.voting_window}, "
+          f"best checkpoint {result.best_path}")
+    write_json(args.json, {
+        "category": category, "variant": cfg.model.model.variant, "epochs_run": result.epochs_run,
+        "epochs": cfg.epochs, "best_val_loss": result.best_val_loss,
+        "voting_window": list(result.voting_window), "best_path": str(result.best_path),
+        "log": str(result.log_path),
+    })
+    return 0
