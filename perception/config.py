@@ -151,7 +151,9 @@ class CaptConfig:
 @dataclass(frozen=True)
 class TrainConfig:
     """One training run. ``device`` is "auto" (CUDA when present), "cpu" or "cuda[:i]"; AMP is used on
-    CUDA only. ``max_*_samples`` cap a split (None: all) for quick runs."""
+    CUDA only. ``max_*_samples`` cap a split (None: all) for quick runs. ``rotation_augmentation``:
+    ``so3`` is the paper's (rotation about x, y and z); ``yaw`` rotates about +z only, for clouds in a
+    world frame with known up direction (what a calibrated robot camera gives)."""
 
     model: CaptConfig = field(default_factory=CaptConfig)
     epochs: int = 50
@@ -164,6 +166,7 @@ class TrainConfig:
     amp: bool = True
     grad_clip: float = 1.0
     augment: bool = True
+    rotation_augmentation: Literal["so3", "yaw"] = "so3"
     train_split: str = "train"
     val_split: str = "val"
     max_train_samples: int | None = None

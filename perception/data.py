@@ -157,8 +157,16 @@ def fit_joint_slots(a: dict[str, np.ndarray], num_joints: int) -> dict[str, np.n
     return out
 
 
-def random_rotation(rng: np.random.Generator) -> np.ndarray:
-    """R = Rz Ry Rx with each angle uniform in [-pi, pi] (the paper's augmentation)."""
+def random_rotation(rng: np.random.Generator, mode: str = "so3") -> np.ndarray:
+    """``so3``: R = Rz Ry Rx with each angle uniform in [-pi, pi] (the paper's augmentation).
+    ``yaw``: a rotation about +z only, uniform in [-pi, pi] -- for world-frame clouds whose up
+    direction is known (a calibrated robot camera), where gravity need not be learned away."""
+    if mode == "yaw":
+        az = rng.uniform(-np.pi, np.pi)
+        cz, sz = np.cos(az), np.sin(az)
+        return np.array([[cz, -sz, 0.0], [sz, cz, 0.0], [0.0, 0.0, 1.0]])
+    if mode != "so3":
+        raise ValueError(f"rotation mode must be 'so3' or 'yaw', got {mode!r}")
     ax, ay, az = rng.uniform(-np.pi, np.pi, size=3)
     cx, sx, cy, sy, cz, sz = np.cos(ax), np.sin(ax), np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
     rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
@@ -168,9 +176,10 @@ def random_rotation(rng: np.random.Generator) -> np.ndarray:
 
 
 def augment(sample: Sample, rng: np.random.Generator, translation: float = 1.0,
-            scale_range: tuple[float, float] = (0.8, 1.2)) -> Sample:
-    """x -> s R x + t applied consistently to points and labels (see module docstring)."""
-    rot = random_rotation(rng)
+            scale_range: tuple[float, float] = (0.8, 1.2), rotation: str = "so3") -> Sample:
+    """x -> s R x + t applied consistently to points and labels (see module docstring);
+    ``rotation`` picks R (see :func:`random_rotation`)."""
+    rot = random_rotation(rng, rotation)
     t = rng.uniform(-translation, translation, size=3)
     s = float(rng.uniform(*scale_range))
     prism = (np.asarray(sample.joint_types) == PRISMATIC)
@@ -228,13 +237,14 @@ class CaptShardDataset(Dataset):
     the first samples only. Call :meth:`set_epoch` each epoch to change the augmentation draw."""
 
     def __init__(self, data_dir: str | Path, split: str, model: ModelConfig, augment: bool = False,
-                 seed: int = 0, max_samples: int | None = None) -> None:
+                 seed: int = 0, max_samples: int | None = None, rotation: str = "so3") -> None:
         arrays = fit_joint_slots(load_split(data_dir, split), model.max_joints)
         if max_samples is not None:
             arrays = {k: v[:max_samples] for k, v in arrays.items()}
         self.arrays = arrays
         self.num_points = model.num_points
         self.augment = augment
+        self.rotation = rotation
         self.seed = seed
         self.epoch = 0
         self._check(model)
@@ -263,7 +273,7 @@ class CaptShardDataset(Dataset):
         rng = np.random.default_rng([self.seed, self.epoch, int(index)])
         s = self.sample(index)
         if self.augment:
-            s = augment(s, rng)
+            s = augment(s, rng, rotation=self.rotation)
         item = prepare_sample(s, self.num_points, rng)
         item["index"] = torch.tensor(int(index))
         return item

@@ -249,7 +249,8 @@ def generate(cfg: GenerateConfig, out_dir: str | Path, workers: int | None = Non
     shards = {s: sum(1 for j in jobs if j.split == s) for s in SPLITS}
     _write_manifest(out_dir, cfg, {"complete": True, "counts": counts, "shards": shards})
     return {
-        "out_dir": str(out_dir), "counts": counts, "rendered_now": rendered,
+        "out_dir": str(out_dir), "category": cfg.category, "seed": cfg.seed, "counts": counts,
+        "rendered_now": rendered,
         "skipped_shards": len(jobs) - len(todo), "workers": workers, "seconds": elapsed,
         "samples_per_second": rendered / elapsed if rendered and elapsed > 0 else None,
     }

@@ -106,3 +106,17 @@ def test_yaml_configs_load_and_validate():
         from_dict(CaptConfig, {"voting": {"w0": 2.0, "w1": 1.0}})
     with pytest.raises(ConfigError, match="unknown"):
         from_dict(TrainConfig, {"epochs": 2, "bogus": 1})
+
+
+def test_yaw_rotation_keeps_up_direction() -> None:
+    import numpy as np
+
+    from perception.data import random_rotation
+
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        rot = random_rotation(rng, "yaw")
+        np.testing.assert_allclose(rot @ np.array([0.0, 0.0, 1.0]), [0.0, 0.0, 1.0], atol=1e-12)
+        np.testing.assert_allclose(rot @ rot.T, np.eye(3), atol=1e-12)
+    full = random_rotation(rng, "so3")
+    assert abs((full @ np.array([0.0, 0.0, 1.0]))[2]) < 1.0
