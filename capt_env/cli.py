@@ -13,9 +13,11 @@ import sys
 # verb -> (module under capt_env.commands, one-line help)
 VERBS: dict[str, tuple[str, str]] = {
     "doctor": ("doctor", "rendering device SAPIEN sees, versions, and what to install"),
+    "demo": ("demo", "the main job: estimate unseen objects' joints with CAPT, then open them"),
     "generate": ("generate", "render a labelled point-cloud dataset of one category as shards"),
     "train": ("train", "train a CAPT variant (capt, capt_plain, pct_regression) on a generated dataset"),
     "evaluate": ("evaluate", "the paper's Table I and time per input for checkpoints, side by side"),
+    "rollout": ("rollout", "success rate of the scripted policy per category and perception source"),
     "bench": ("bench", "environment speed: steps/s in state and pointcloud mode, reset time"),
 }
 

@@ -56,9 +56,10 @@ class TaskConfig:
     or a URDF/MJCF file ``object`` (then ``joint`` names the joint to open; default the first
     movable one, and ``scale`` scales it). Exactly one of ``category``/``object`` is set.
 
-    Placement (world frame, metres/radians): the object's base centre is put at
+    Placement (world frame, metres/radians): the object's bounding-box centre is put at
     ``object_xy`` +- ``object_xy_noise`` on the table top, its front facing the robot, turned by a
-    yaw uniform in +-``yaw_noise``.
+    yaw uniform in +-``yaw_noise``. The Panda's base is at (-0.615, 0) and its resting hand near
+    x = 0; the default 0.3 m keeps deep objects (ovens, cabinets) clear of the hand at reset.
 
     Joint states at reset: the target joint starts at a fraction of its range uniform in
     ``target_init_fraction``; other joints uniform in ``other_init_fraction`` of their ranges.
@@ -73,7 +74,7 @@ class TaskConfig:
     scale: float = 1.0
     split: Split = "train"
     instance_ids: tuple[int, ...] | None = None
-    object_xy: tuple[float, float] = (0.12, 0.0)
+    object_xy: tuple[float, float] = (0.3, 0.0)
     object_xy_noise: tuple[float, float] = (0.05, 0.05)
     yaw_noise: float = 0.2
     target_init_fraction: tuple[float, float] = (0.0, 0.05)

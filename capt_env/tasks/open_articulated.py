@@ -1,6 +1,6 @@
 """ManiSkill3 task: a Panda arm on a table opens one articulated object seen by depth cameras.
 
-**Task.** A Panda (``pd_ee_delta_pose`` by default) stands at the table edge; an articulated object
+**Task.** A Panda (control mode ``pd_ee_delta_pose`` by default; any Panda mode can be passed) stands at the table edge; an articulated object
 (a procedural category instance, or a user URDF/MJCF file) stands on the table with its front to the
 robot. The robot must open the target joint: swing the door/lid about its hinge, or pull the drawer.
 
@@ -50,6 +50,9 @@ from capt_env.tasks.object_loading import LoadedObject, load_object
 from perception.yaml_config import from_dict
 
 JOINT_TYPE_IDS = {"revolute": 0, "prismatic": 1}
+# End-effector deltas: [-1, 1] maps to +-0.1 m / +-0.1 rad per 20 Hz control step (ManiSkill 3.0.1
+# applies the rotation part with a negative scale: a +1 rotation action turns by -0.1 rad).
+DEFAULT_CONTROL_MODE = "pd_ee_delta_pose"
 ROBOT_BASE_XY = (-0.615, 0.0)
 
 
@@ -100,6 +103,7 @@ class OpenArticulatedEnv(BaseEnv):
         self.object: LoadedObject | None = None
         if reconfiguration_freq is None:
             reconfiguration_freq = 1 if num_envs == 1 else 0
+        kwargs.setdefault("control_mode", DEFAULT_CONTROL_MODE)
         from capt_env.rendering import translate_render_error
 
         with translate_render_error():

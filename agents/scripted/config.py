@@ -1,0 +1,58 @@
+"""Typed config of the scripted opener (metres, radians, control steps at 20 Hz)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from perception.yaml_config import require
+
+
+@dataclass(frozen=True)
+class ScriptedOpenerConfig:
+    """Gains, offsets and targets of :class:`agents.scripted.opener.ScriptedOpener`.
+
+    Approach: pre-grasp ``pregrasp_offset`` m outside the grasp point along the part's outward
+    normal, then ``grasp_depth`` m past it; the approach direction points at least ``approach_pitch``
+    rad below horizontal (a level Panda hand near the table is beyond its wrist limits). Moves are capped at
+    ``max_step_m`` / ``max_step_rad`` per control step; ``pos_tolerance`` / ``rot_tolerance`` end
+    a move, as do ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact).
+    ``close_steps`` steps close the gripper. Pulling leads the part by ``revolute_lead`` rad
+    or ``prismatic_lead`` m and stops at ``revolute_target`` rad / ``prismatic_target`` m, or when
+    the state grew by less than ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps``
+    steps (a limit, or a lost grip). The gripper
+    re-grasps (at most ``max_regrasps`` times) if it drifts more than ``slip_distance`` m from the
+    part. After release it backs off ``retreat_distance`` m.
+    """
+
+    pregrasp_offset: float = 0.08
+    grasp_depth: float = 0.01
+    approach_pitch: float = 0.8
+    max_step_m: float = 0.03
+    max_step_rad: float = 0.15
+    pos_tolerance: float = 0.012
+    rot_tolerance: float = 0.12
+    move_timeout: int = 60
+    blocked_steps: int = 6
+    close_steps: int = 8
+    revolute_lead: float = 0.12
+    prismatic_lead: float = 0.03
+    revolute_target: float = 1.7
+    prismatic_target: float = 0.4
+    stall_progress: float = 0.02
+    stall_progress_m: float = 0.004
+    stall_steps: int = 12
+    slip_distance: float = 0.07
+    max_regrasps: int = 2
+    retreat_distance: float = 0.08
+    release_steps: int = 6
+
+    def validate(self) -> None:
+        for key in ("pregrasp_offset", "max_step_m", "max_step_rad", "pos_tolerance", "rot_tolerance",
+                    "revolute_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
+                    "revolute_target", "prismatic_target",
+                    "slip_distance"):
+            require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
+        for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps"):
+            require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")
+        require(self.max_regrasps >= 0, "max_regrasps must be >= 0")
+        require(0 <= self.approach_pitch <= 1.5, "approach_pitch must be in [0, 1.5] rad")

@@ -1,0 +1,39 @@
+"""Rotation helpers of the scripted opener (world frame; quaternions wxyz like ManiSkill)."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+
+def quat_to_matrix(q_wxyz: np.ndarray) -> np.ndarray:
+    """(4,) wxyz quaternion -> (3, 3) rotation matrix."""
+    return Rotation.from_quat(np.asarray(q_wxyz, dtype=np.float64), scalar_first=True).as_matrix()
+
+
+def axis_angle_matrix(axis: np.ndarray, angle: float) -> np.ndarray:
+    """(3, 3) rotation by ``angle`` radians about unit ``axis`` (3,)."""
+    return Rotation.from_rotvec(np.asarray(axis, dtype=np.float64) * angle).as_matrix()
+
+
+def rotation_error(r_des: np.ndarray, r_cur: np.ndarray) -> np.ndarray:
+    """World-frame rotation vector (3,) radians taking ``r_cur`` to ``r_des`` (R_des = R(e) R_cur)."""
+    return Rotation.from_matrix(r_des @ r_cur.T).as_rotvec()
+
+
+def perpendicular(v: np.ndarray, hint: np.ndarray) -> np.ndarray | None:
+    """Unit component of ``hint`` perpendicular to unit ``v``; None when they are (near) parallel."""
+    w = hint - float(hint @ v) * v
+    n = float(np.linalg.norm(w))
+    return None if n < 1e-3 else w / n
+
+
+def grasp_frame(approach: np.ndarray, closing: np.ndarray) -> np.ndarray:
+    """Panda TCP rotation (columns x, y = finger closing, z = approach), as ManiSkill's build_grasp_pose."""
+    return np.stack([np.cross(closing, approach), closing, approach], axis=1)
+
+
+def clip_norm(v: np.ndarray, max_norm: float) -> np.ndarray:
+    """``v`` scaled down to norm ``max_norm`` if longer."""
+    n = float(np.linalg.norm(v))
+    return v if n <= max_norm else v * (max_norm / n)

@@ -1,0 +1,247 @@
+"""Scripted opening policy for any 1-DoF part, driven only by the joint-axis estimate.
+
+Control mode: ``pd_ee_delta_pose`` (Panda). Actions are bounded per-step pose increments (0.1 m and
+0.1 rad per unit action, translation and rotation in world-aligned axes about the TCP; note that
+ManiSkill 3.0.1 negates the rotation part, see ``ACTION_SCALE_RAD``), so every
+step is closed-loop on the measured TCP pose and on the latest estimate, large jumps of a noisy
+estimate cannot produce large motions, and the same actions work with CPU and GPU simulation.
+(``pd_ee_pose`` would need a reachable absolute target each step and gives no speed bound.)
+
+Strategy, per episode:
+
+1. ``PREGRASP``: open the gripper and move to ``pregrasp_offset`` outside the grasp point along the
+   part's outward normal ``n`` (revolute: the opening direction of the grasp point,
+   ``axis x (grasp - pivot)``; prismatic: the axis), with the TCP approach axis along ``-n`` and the
+   fingers closing perpendicular to the handle (revolute: along the radius from the axis, so a bar
+   parallel to the hinge is enclosed; prismatic: vertically). The approach is pitched at least
+   ``approach_pitch`` below horizontal (the Panda's wrist cannot point level near the table).
+2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper.
+4. ``PULL``: the target TCP pose is the grasp pose moved with the part to state
+   ``state_now + lead``: rotated about the estimated axis (revolute) or shifted along it
+   (prismatic); the estimate is re-read every step, so re-estimation corrects the path.
+5. ``RELEASE`` when the estimated state reaches the target (or stops growing: a limit), open, and
+   ``RETREAT`` along the outward normal; then ``DONE`` (hold still, gripper open).
+If the TCP drifts from the part's grasp point while pulling, it goes back to 1 (bounded re-grasps).
+"""
+
+from __future__ import annotations
+
+import enum
+from typing import Any
+
+import numpy as np
+
+from agents.scripted.config import ScriptedOpenerConfig
+from agents.scripted.geometry import (
+    axis_angle_matrix,
+    clip_norm,
+    grasp_frame,
+    perpendicular,
+    quat_to_matrix,
+    rotation_error,
+)
+from capt_env.wrappers.estimate import JointAxisEstimate, unit
+from capt_env.wrappers.joint_observation import decode_observation
+
+GRIPPER_OPEN = 1.0
+GRIPPER_CLOSE = -1.0
+ACTION_SCALE_M = 0.1  # pd_ee_delta_pose: metres per unit translation action
+# ManiSkill 3.0.1's PDEEPoseController multiplies rotation actions by ``rot_lower`` (-0.1 for the Panda),
+# so a unit rotation action turns by -0.1 rad (XYZ Euler ~ rotation vector at these small angles).
+ACTION_SCALE_RAD = -0.1
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+class Phase(enum.Enum):
+    PREGRASP = "pregrasp"
+    APPROACH = "approach"
+    CLOSE = "close"
+    PULL = "pull"
+    RELEASE = "release"
+    RETREAT = "retreat"
+    DONE = "done"
+
+
+def outward_normal(est: JointAxisEstimate) -> np.ndarray:
+    """World-frame unit direction in which the grasp point moves when the part opens."""
+    u = unit(est.direction)
+    if est.joint_type == "prismatic":
+        return u
+    return unit(np.cross(u, est.grasp_point - est.pivot))
+
+
+def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig) -> np.ndarray:
+    """TCP rotation (3, 3) for grasping: approach along -n, fingers closing across the handle.
+
+    Of the two finger orientations (closing c or -c) the one nearer ``current`` is chosen.
+    """
+    n = outward_normal(est)
+    approach = -n
+    if est.joint_type == "revolute":
+        closing = perpendicular(approach, est.grasp_point - est.pivot)
+    else:
+        closing = perpendicular(approach, _UP)
+    if closing is None:
+        closing = perpendicular(approach, np.array([0.0, 1.0, 0.0]))
+        assert closing is not None
+    frame = grasp_frame(approach, closing)
+    elevation = float(np.arcsin(np.clip(approach[2], -1.0, 1.0)))
+    horizontal = perpendicular(approach, _UP)
+    if elevation > -cfg.approach_pitch and horizontal is not None:
+        # point the hand down by turning about the horizontal axis across the approach: the Panda's
+        # wrist cannot point level at table height, and a handle bar stays between the fingers
+        # (the bar is either along that axis or perpendicular to the closing direction)
+        side = np.cross(approach, _UP)
+        side = side / np.linalg.norm(side)
+        rot = axis_angle_matrix(side, -(elevation + cfg.approach_pitch))
+        if (rot @ approach)[2] > approach[2]:
+            rot = rot.T
+        frame = rot @ frame
+    flipped = frame @ np.diag([-1.0, -1.0, 1.0])  # same approach, fingers swapped
+    if np.linalg.norm(rotation_error(flipped, current)) < np.linalg.norm(rotation_error(frame, current)):
+        frame = flipped
+    return frame
+
+
+class ScriptedOpener:
+    """Opens the estimated joint. ``act(obs, info)`` takes the wrapper's flat or dict observation.
+
+    The policy reads only the TCP pose and the estimate in ``obs``; ``info`` is accepted for the
+    common policy signature and is not used.
+    """
+
+    def __init__(self, config: ScriptedOpenerConfig | None = None) -> None:
+        self.cfg = config or ScriptedOpenerConfig()
+        self.cfg.validate()
+        self.reset()
+
+    def reset(self) -> None:
+        """Start a new episode."""
+        self.phase = Phase.PREGRASP
+        self.phase_steps = 0
+        self.regrasps = 0
+        self._grasp_p: np.ndarray | None = None
+        self._grasp_r: np.ndarray | None = None
+        self._grasp_state = 0.0
+        self._target_r: np.ndarray | None = None
+        self._history: list[float] = []
+        self._retreat_from: np.ndarray | None = None
+        self._still = 0
+        self._last_p: np.ndarray | None = None
+        self._last_err = (0.0, 0.0)
+
+    # --------------------------------------------------------------- helpers
+    def _goto(self, p: np.ndarray, r: np.ndarray, p_des: np.ndarray, r_des: np.ndarray,
+              gripper: float) -> tuple[np.ndarray, float, float]:
+        dp = clip_norm(p_des - p, self.cfg.max_step_m)
+        dr = clip_norm(rotation_error(r_des, r), self.cfg.max_step_rad)
+        action = np.concatenate([dp / ACTION_SCALE_M, dr / ACTION_SCALE_RAD, [gripper]])
+        return (np.clip(action, -1.0, 1.0).astype(np.float32), float(np.linalg.norm(p_des - p)),
+                float(np.linalg.norm(rotation_error(r_des, r))))
+
+    def _set(self, phase: Phase) -> None:
+        self.phase = phase
+        self.phase_steps = 0
+        self._still = 0
+        self._last_p = None
+
+    def _reached(self, p: np.ndarray, perr: float, rerr: float) -> bool:
+        """A move ends at the goal, on timeout, or when blocked (TCP still for ``blocked_steps``)."""
+        moved = self._last_p is None or abs(perr - self._last_err[0]) > 0.002 or (
+            abs(rerr - self._last_err[1]) > 0.01)
+        self._still = 0 if moved or self.phase_steps <= 3 else self._still + 1
+        self._last_p, self._last_err = p.copy(), (perr, rerr)
+        return (perr < self.cfg.pos_tolerance and rerr < self.cfg.rot_tolerance) or (
+            self.phase_steps >= self.cfg.move_timeout) or self._still >= self.cfg.blocked_steps
+
+    # ------------------------------------------------------------------- act
+    def act(self, obs: np.ndarray | dict[str, np.ndarray], info: dict[str, Any] | None = None) -> np.ndarray:
+        """Action (7,) in [-1, 1] for ``pd_ee_delta_pose`` from a joint-axis observation."""
+        proprio, est = decode_observation(obs)
+        return self.act_on(est, proprio["tcp_pose"])
+
+    def act_on(self, est: JointAxisEstimate, tcp_pose: np.ndarray) -> np.ndarray:
+        """Action (7,) from an estimate and the TCP pose (7,) (position m, quaternion wxyz), world frame."""
+        cfg = self.cfg
+        p = np.asarray(tcp_pose[:3], dtype=np.float64)
+        r = quat_to_matrix(tcp_pose[3:7])
+        self.phase_steps += 1
+
+        if self.phase in (Phase.PREGRASP, Phase.APPROACH):
+            if self._target_r is None or self.phase == Phase.PREGRASP and self.phase_steps == 1:
+                self._target_r = grasp_rotation(est, r, cfg)
+            approach = self._target_r[:, 2]
+            if self.phase == Phase.PREGRASP:
+                goal = est.grasp_point - approach * cfg.pregrasp_offset
+            else:
+                goal = est.grasp_point + approach * cfg.grasp_depth
+            action, perr, rerr = self._goto(p, r, goal, self._target_r, GRIPPER_OPEN)
+            if self._reached(p, perr, rerr):
+                self._set(Phase.APPROACH if self.phase == Phase.PREGRASP else Phase.CLOSE)
+            return action
+
+        if self.phase == Phase.CLOSE:
+            action = np.zeros(7, np.float32)
+            action[6] = GRIPPER_CLOSE
+            if self.phase_steps >= cfg.close_steps:
+                self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
+                self._history = []
+                self._set(Phase.PULL)
+            return action
+
+        if self.phase == Phase.PULL:
+            return self._pull(est, p, r)
+
+        if self.phase == Phase.RELEASE:
+            action = np.zeros(7, np.float32)
+            action[6] = GRIPPER_OPEN
+            if self.phase_steps >= cfg.release_steps:
+                self._retreat_from = p.copy()
+                self._set(Phase.RETREAT)
+            return action
+
+        if self.phase == Phase.RETREAT:
+            assert self._retreat_from is not None
+            goal = self._retreat_from - r[:, 2] * cfg.retreat_distance
+            action, perr, _ = self._goto(p, r, goal, r, GRIPPER_OPEN)
+            if perr < cfg.pos_tolerance or self.phase_steps >= cfg.move_timeout:
+                self._set(Phase.DONE)
+            return action
+
+        action = np.zeros(7, np.float32)
+        action[6] = GRIPPER_OPEN
+        return action
+
+    def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray) -> np.ndarray:
+        cfg = self.cfg
+        assert self._grasp_p is not None and self._grasp_r is not None
+        self._history.append(est.state)
+        revolute = est.joint_type == "revolute"
+        target = cfg.revolute_target if revolute else cfg.prismatic_target
+        min_progress = cfg.stall_progress if revolute else cfg.stall_progress_m
+        stalled = (len(self._history) > cfg.stall_steps
+                   and self._history[-1] - self._history[-1 - cfg.stall_steps] < min_progress)
+        if est.state >= target or stalled:
+            self._set(Phase.RELEASE)
+            action = np.zeros(7, np.float32)
+            action[6] = GRIPPER_CLOSE
+            return action
+        if np.linalg.norm(p - est.grasp_point) > cfg.slip_distance and self.regrasps < cfg.max_regrasps:
+            self.regrasps += 1
+            self._target_r = None
+            self._set(Phase.PREGRASP)
+            action = np.zeros(7, np.float32)
+            action[6] = GRIPPER_OPEN
+            return action
+        u = unit(est.direction)
+        if revolute:
+            delta = est.state - self._grasp_state + cfg.revolute_lead
+            rot = axis_angle_matrix(u, delta)
+            p_des = est.pivot + rot @ (self._grasp_p - est.pivot)
+            r_des = rot @ self._grasp_r
+        else:
+            delta = est.state - self._grasp_state + cfg.prismatic_lead
+            p_des = self._grasp_p + u * delta
+            r_des = self._grasp_r
+        action, _, _ = self._goto(p, r, p_des, r_des, GRIPPER_CLOSE)
+        return action

@@ -1,0 +1,71 @@
+"""``capt rollout``: success rate of a policy with a perception source on unseen (test-split) instances."""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import asdict
+
+from capt_env.commands.json_output import write_json
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--categories", nargs="+", default=["cabinet_door"], help="object categories")
+    parser.add_argument("--policy", default="scripted", choices=["scripted"],
+                        help="policy (PPO is not implemented yet)")
+    parser.add_argument("--perception", nargs="+", default=["oracle"],
+                        choices=["oracle", "noisy_oracle", "capt"], help="perception sources to compare")
+    parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
+    parser.add_argument("--episodes", type=int, default=10, help="episodes per category and source")
+    parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
+    parser.add_argument("--every-k-steps", type=int, default=5, help="perception period in env steps")
+    parser.add_argument("--max-steps", type=int, default=200)
+    parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
+
+
+def run(args: argparse.Namespace) -> int:
+    import numpy as np
+    from tqdm import tqdm
+
+    from agents.scripted.opener import ScriptedOpener
+    from agents.scripted.rollout import make_env, run_episode
+    from agents.success_stats import wilson_interval
+
+    rows, lines = [], ["| category | perception | success | 95% interval | mean opened | mean steps | episodes |",
+                       "| --- | --- | --- | --- | --- | --- | --- |"]
+    seeds = list(range(args.first_seed, args.first_seed + args.episodes))
+    for category in args.categories:
+        for source in args.perception:
+            wrapper = {"source": source, "every_k_steps": args.every_k_steps}
+            obs_mode = "state"
+            if source == "capt":
+                from perception.checkpoints import default_checkpoint
+
+                wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
+                obs_mode = "pointcloud"
+            env = make_env(category, wrapper, obs_mode=obs_mode)
+            policy = ScriptedOpener()
+            try:
+                episodes = [run_episode(env, policy, s, args.max_steps)
+                            for s in tqdm(seeds, desc=f"{category} {source}")]
+            finally:
+                env.close()
+            wins = sum(e.success for e in episodes)
+            lo, hi = wilson_interval(wins, len(episodes))
+            row = {"category": category, "policy": args.policy, "perception": source,
+                   "success_rate": wins / len(episodes), "ci95": [lo, hi],
+                   "mean_open_fraction": float(np.mean([e.open_fraction for e in episodes])),
+                   "mean_steps": float(np.mean([e.steps for e in episodes])),
+                   "episodes": [asdict(e) for e in episodes]}
+            rows.append(row)
+            lines.append(f"| {category} | {source} | {row['success_rate']:.2f} | [{lo:.2f}, {hi:.2f}] | "
+                         f"{row['mean_open_fraction']:.2f} | {row['mean_steps']:.0f} | {len(episodes)} |")
+    table = "\n".join(lines)
+    print(table)
+    if args.markdown:
+        from pathlib import Path
+
+        Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.markdown).write_text(table + "\n")
+    write_json(args.json, {"seeds": seeds, "policy": args.policy, "max_steps": args.max_steps,
+                           "every_k_steps": args.every_k_steps, "results": rows})
+    return 0

@@ -1,0 +1,94 @@
+"""Typed configs of the perception wrapper and of object isolation (YAML via perception.yaml_config)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from perception.yaml_config import require
+
+Source = Literal["oracle", "noisy_oracle", "capt"]
+IsolationMode = Literal["segmentation", "geometric"]
+ObsFormat = Literal["flat", "dict"]
+
+
+@dataclass(frozen=True)
+class IsolationConfig:
+    """How object points are cut from a world-frame cloud (metres, world frame).
+
+    ``mode``: ``segmentation`` keeps points with part label >= 0 (simulation only); ``geometric``
+    uses no labels: table plane removal by RANSAC (``plane_iterations`` hypotheses, inlier band
+    ``plane_threshold``, points up to ``plane_margin`` above the plane are dropped too), a
+    workspace crop to the box ``workspace_min``..``workspace_max``, removal of points within
+    ``robot_margin`` of the robot's collision shapes, and statistical outlier removal (mean distance
+    to the ``outlier_k`` nearest neighbours above mean + ``outlier_std`` * std is dropped).
+    ``seed`` seeds RANSAC.
+    """
+
+    mode: IsolationMode = "segmentation"
+    plane_iterations: int = 200
+    plane_threshold: float = 0.004
+    plane_margin: float = 0.002
+    workspace_min: tuple[float, float, float] = (-0.45, -0.6, -0.05)
+    workspace_max: tuple[float, float, float] = (0.8, 0.6, 1.2)
+    robot_margin: float = 0.01
+    outlier_k: int = 8
+    outlier_std: float = 3.0
+    seed: int = 0
+
+    def validate(self) -> None:
+        require(self.plane_iterations >= 1, "isolation.plane_iterations must be >= 1")
+        require(self.plane_threshold > 0, "isolation.plane_threshold must be > 0 (metres)")
+        require(self.plane_margin >= 0, "isolation.plane_margin must be >= 0 (metres)")
+        require(all(lo < hi for lo, hi in zip(self.workspace_min, self.workspace_max, strict=True)),
+                "isolation.workspace_min must be below workspace_max on every axis")
+        require(self.robot_margin >= 0, "isolation.robot_margin must be >= 0 (metres)")
+        require(self.outlier_k >= 1, "isolation.outlier_k must be >= 1")
+        require(self.outlier_std > 0, "isolation.outlier_std must be > 0")
+
+
+@dataclass(frozen=True)
+class NoiseConfig:
+    """Noise of the ``noisy_oracle`` source: the axis direction is tilted by an angle drawn from
+    N(0, ``direction_rad``) (radians) about a random perpendicular axis; pivot and grasp point get
+    isotropic Gaussian offsets with per-axis std ``pivot_m`` / ``grasp_m`` (metres); the state gets
+    N(0, ``state``) (radians or metres)."""
+
+    direction_rad: float = 0.05
+    pivot_m: float = 0.01
+    state: float = 0.02
+    grasp_m: float = 0.005
+
+    def validate(self) -> None:
+        for key in ("direction_rad", "pivot_m", "state", "grasp_m"):
+            require(getattr(self, key) >= 0, f"noise.{key} must be >= 0, got {getattr(self, key)}")
+        require(self.direction_rad <= 3.15, "noise.direction_rad must be <= pi")
+
+
+@dataclass(frozen=True)
+class PerceptionWrapperConfig:
+    """What :class:`~capt_env.wrappers.perception_wrapper.CaptObservationWrapper` does.
+
+    ``source``: ``oracle`` (ground truth from info), ``noisy_oracle`` (ground truth + ``noise``) or
+    ``capt`` (a CAPT ``checkpoint``, loaded lazily on first use). Perception runs on reset and then
+    every ``every_k_steps`` steps; in between the last estimate is repeated. ``isolation`` selects the
+    object points fed to CAPT, downsampled to ``num_points``. ``obs_format``: ``flat`` (Box) or
+    ``dict``. ``seed`` seeds noise and downsampling.
+    """
+
+    source: Source = "oracle"
+    checkpoint: str | None = None
+    every_k_steps: int = 1
+    isolation: IsolationConfig = field(default_factory=IsolationConfig)
+    num_points: int = 1024
+    noise: NoiseConfig = field(default_factory=NoiseConfig)
+    obs_format: ObsFormat = "flat"
+    seed: int = 0
+
+    def validate(self) -> None:
+        require(self.every_k_steps >= 1, f"every_k_steps must be >= 1, got {self.every_k_steps}")
+        require(self.num_points >= 32, f"num_points must be >= 32, got {self.num_points}")
+        if self.source == "capt":
+            require(self.checkpoint is not None, "source 'capt' needs a checkpoint path")
+        self.isolation.validate()
+        self.noise.validate()

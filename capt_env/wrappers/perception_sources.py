@@ -1,0 +1,142 @@
+"""Where joint estimates come from: ground truth (oracle), ground truth plus noise, or CAPT.
+
+Every source maps (object points, env info) to a world-frame :class:`JointAxisEstimate` of the target
+joint. Only :class:`CaptSource` needs the points; it imports ``perception.inference`` lazily, on the
+first estimate, so the oracle sources work without torch models or checkpoints.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol
+
+import numpy as np
+
+from capt_env.wrappers.config import NoiseConfig
+from capt_env.wrappers.estimate import (
+    JOINT_TYPES,
+    JointAxisEstimate,
+    canonical_pivot,
+    grasp_point_of_part,
+    unit,
+)
+
+
+class PerceptionSource(Protocol):
+    """Anything that estimates the target joint. ``needs_points``: whether it reads the cloud."""
+
+    needs_points: bool
+
+    def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
+        """Estimate from object points (M, 3) world frame metres (or None) and the env's info."""
+        ...
+
+
+def _target(info: dict[str, Any]) -> int:
+    return int(np.asarray(info["target_joint"]).reshape(-1)[0])
+
+
+def ground_truth_estimate(info: dict[str, Any]) -> JointAxisEstimate:
+    """The target joint's ground truth from a capt_env info dict (world frame), pivot made canonical."""
+    k = _target(info)
+    axis = unit(np.asarray(info["joint_axis"], dtype=np.float64)[k])
+    grasp = np.asarray(info["grasp_point"], dtype=np.float64).reshape(3)
+    pivot = canonical_pivot(axis, np.asarray(info["joint_pivot"], dtype=np.float64)[k], grasp)
+    return JointAxisEstimate(
+        joint_type=JOINT_TYPES[int(np.asarray(info["joint_type"])[k])], direction=axis, pivot=pivot,
+        state=float(np.asarray(info["joint_state"])[k]), grasp_point=grasp, confidence=1.0,
+    )
+
+
+class OracleSource:
+    """Ground truth from ``info`` (the simulator's joints and grasp point)."""
+
+    needs_points = False
+
+    def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
+        return ground_truth_estimate(info)
+
+
+def tilt(direction: np.ndarray, angle: float, rng: np.random.Generator) -> np.ndarray:
+    """``direction`` (3,) rotated by ``angle`` radians about a uniformly random perpendicular axis."""
+    u = unit(direction)
+    r = rng.normal(size=3)
+    perp = unit(r - (r @ u) * u)
+    return np.cos(angle) * u + np.sin(angle) * perp
+
+
+class NoisyOracleSource:
+    """Ground truth plus Gaussian noise of the magnitudes in :class:`NoiseConfig`, seeded.
+
+    The direction is tilted by ``|N(0, direction_rad)|`` radians; the noisy pivot is then made canonical
+    again (closest to the noisy grasp point) so only the off-axis part of the pivot noise remains.
+    """
+
+    needs_points = False
+
+    def __init__(self, noise: NoiseConfig, seed: int = 0) -> None:
+        self.noise = noise
+        self.rng = np.random.default_rng(seed)
+
+    def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
+        gt = ground_truth_estimate(info)
+        n, rng = self.noise, self.rng
+        direction = tilt(gt.direction, abs(float(rng.normal(0.0, n.direction_rad))), rng)
+        grasp = gt.grasp_point + rng.normal(0.0, n.grasp_m, size=3)
+        pivot = canonical_pivot(direction, gt.pivot + rng.normal(0.0, n.pivot_m, size=3), grasp)
+        state = gt.state + float(rng.normal(0.0, n.state))
+        return JointAxisEstimate(gt.joint_type, direction, pivot, state, grasp, confidence=1.0)
+
+
+class CaptSource:
+    """CAPT (``perception.inference.ArticulationEstimator``) on the isolated object points.
+
+    The checkpoint is loaded on the first call. The target joint's channel is the env's target joint
+    index; the grasp point comes from the points CAPT labels as that joint's moving part (all points
+    if it labels none).
+    """
+
+    needs_points = True
+
+    def __init__(self, checkpoint: str, seed: int = 0) -> None:
+        self.checkpoint = checkpoint
+        self.seed = seed
+        self._estimator: Any = None
+
+    def _load(self) -> Any:
+        if self._estimator is None:
+            from perception.inference import ArticulationEstimator  # lazy: only the capt source
+
+            self._estimator = ArticulationEstimator.from_checkpoint(self.checkpoint, seed=self.seed)
+        return self._estimator
+
+    def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
+        if points is None:
+            raise ValueError("the capt source needs the object's points")
+        est = self._load()
+        result = est.predict(np.asarray(points, dtype=np.float64))
+        k = min(_target(info), len(result.joints) - 1)
+        joint = result.joints[k]
+        child_parts = getattr(est.config.model, "joint_child_parts", None)
+        moving = points
+        if child_parts is not None and k < len(child_parts):
+            mask = np.asarray(result.part_labels) == int(child_parts[k])
+            if mask.sum() >= 3:
+                moving = points[mask]
+        direction = unit(joint.direction)
+        grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
+        pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
+        return JointAxisEstimate(joint.type, direction, pivot, float(joint.state), grasp,
+                                 float(joint.confidence))
+
+
+def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: int) -> PerceptionSource:
+    """The source named ``source`` ("oracle", "noisy_oracle", "capt")."""
+    if source == "oracle":
+        return OracleSource()
+    if source == "noisy_oracle":
+        return NoisyOracleSource(noise, seed)
+    if source == "capt":
+        if checkpoint is None:
+            raise ValueError("source 'capt' needs a checkpoint path")
+        return CaptSource(checkpoint, seed)
+    raise ValueError(f"unknown perception source {source!r}")

@@ -1,0 +1,61 @@
+"""The flat joint-axis observation matches its documented layout, and encodes/decodes losslessly."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part
+from capt_env.wrappers.joint_observation import (
+    OBSERVATION_SIZE,
+    build_dict,
+    decode_observation,
+    dict_space,
+    flat_space,
+    flatten,
+    observation_layout,
+)
+
+
+def _estimate() -> JointAxisEstimate:
+    return JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.array([0.1, 0.2, 0.3]), 0.05,
+                             np.array([0.0, 0.2, 0.3]), 0.8)
+
+
+def test_layout_tiles_the_space_and_matches_the_docstring() -> None:
+    layout = observation_layout()
+    starts = sorted((s.start, s.stop) for s in layout.values())
+    assert starts[0][0] == 0 and starts[-1][1] == OBSERVATION_SIZE
+    assert all(a[1] == b[0] for a, b in zip(starts, starts[1:], strict=False))
+    assert flat_space().shape == (OBSERVATION_SIZE,) and flat_space().dtype == np.float32
+    import capt_env.wrappers.joint_observation as module
+
+    for name, sl in layout.items():  # every row of the docstring table names the same slice
+        assert f"{name} " in module.__doc__ and f"{sl.start}:{sl.stop}" in module.__doc__
+        assert dict_space()[name].shape == (sl.stop - sl.start,)
+
+
+def test_round_trip_through_flat_and_dict() -> None:
+    qpos, qvel, tcp = np.arange(9.0), -np.arange(9.0), np.array([0.1, 0.2, 0.3, 1, 0, 0, 0])
+    d = build_dict(qpos, qvel, tcp, _estimate())
+    flat = flatten(d)
+    assert flat_space().contains(flat) and dict_space().contains(d)
+    layout = observation_layout()
+    np.testing.assert_allclose(flat[layout["joint_type"]], [0.0, 1.0])
+    np.testing.assert_allclose(flat[layout["qvel"]], qvel)
+    for obs in (flat, d):
+        proprio, est = decode_observation(obs)
+        assert est.joint_type == "prismatic"
+        np.testing.assert_allclose(est.pivot, [0.1, 0.2, 0.3], atol=1e-6)
+        np.testing.assert_allclose(proprio["tcp_pose"], tcp, atol=1e-6)
+        assert abs(est.confidence - 0.8) < 1e-6 and abs(est.state - 0.05) < 1e-6
+
+
+def test_canonical_pivot_and_far_edge_grasp_point() -> None:
+    u = np.array([0.0, 0.0, 1.0])
+    np.testing.assert_allclose(canonical_pivot(u, np.zeros(3), np.array([0.3, 0.0, 0.5])), [0, 0, 0.5])
+    rng = np.random.default_rng(0)
+    door = np.stack([rng.uniform(0.0, 0.4, 2000), np.zeros(2000), rng.uniform(0.0, 0.5, 2000)], axis=1)
+    g = grasp_point_of_part(door, "revolute", u, np.zeros(3))
+    assert g[0] > 0.38  # the edge far from the hinge at x = 0
+    g = grasp_point_of_part(door, "prismatic", np.array([1.0, 0.0, 0.0]), np.zeros(3))
+    assert g[0] > 0.38
