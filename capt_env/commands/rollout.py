@@ -30,8 +30,8 @@ def run(args: argparse.Namespace) -> int:
     from agents.scripted.rollout import make_env, run_episode
     from agents.success_stats import wilson_interval
 
-    rows, lines = [], ["| category | perception | success | 95% interval | mean opened | mean steps | episodes |",
-                       "| --- | --- | --- | --- | --- | --- | --- |"]
+    header = "| category | perception | success | 95% interval | mean opened | mean steps | episodes |"
+    rows, lines = [], [header, "| --- | --- | --- | --- | --- | --- | --- |"]
     seeds = list(range(args.first_seed, args.first_seed + args.episodes))
     for category in args.categories:
         for source in args.perception:
