@@ -1,9 +1,9 @@
 """ManiSkill3 task: a Panda arm on a table opens one articulated object seen by depth cameras.
 
 **Task.** A Panda (control mode ``pd_ee_delta_pose`` by default; any Panda mode can be passed)
-stands at the table edge; an articulated object
-(a procedural category instance, or a user URDF/MJCF file) stands on the table with its front to the
-robot. The robot must open the target joint: swing the door/lid about its hinge, or pull the drawer.
+stands at the table edge; an articulated object (a procedural category instance, or a user URDF/MJCF
+file) stands on the table with its front to the robot. The robot must open the target joint: swing
+the door/lid about its hinge, or pull the drawer.
 
 **Randomisations** (per episode, from the episode seed; see :class:`TaskConfig`):
 - the object instance (drawn from the configured split or id list; a new one each reconfiguration,
