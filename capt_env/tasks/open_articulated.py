@@ -46,6 +46,7 @@ from mani_skill.utils import sapien_utils
 from mani_skill.utils.scene_builder.table import TableSceneBuilder
 from mani_skill.utils.structs import Articulation, Pose
 
+from capt_env.rendering import translate_render_error
 from capt_env.tasks.config import TaskConfig
 from capt_env.tasks.object_loading import LoadedObject, load_object
 from perception.yaml_config import from_dict
@@ -105,8 +106,6 @@ class OpenArticulatedEnv(BaseEnv):
         if reconfiguration_freq is None:
             reconfiguration_freq = 1 if num_envs == 1 else 0
         kwargs.setdefault("control_mode", DEFAULT_CONTROL_MODE)
-        from capt_env.rendering import translate_render_error
-
         with translate_render_error():
             super().__init__(
                 *args,
