@@ -17,6 +17,7 @@ VERBS: dict[str, tuple[str, str]] = {
     "generate": ("generate", "render a labelled point-cloud dataset of one category as shards"),
     "train": ("train", "train a CAPT variant (capt, capt_plain, pct_regression) on a generated dataset"),
     "evaluate": ("evaluate", "the paper's Table I and time per input for checkpoints, side by side"),
+    "train-ppo": ("train_ppo", "train PPO on joint-axis observations (train split), resumable"),
     "rollout": ("rollout", "success rate of the scripted policy per category and perception source"),
     "bench": ("bench", "environment speed: steps/s in state and pointcloud mode, reset time"),
 }

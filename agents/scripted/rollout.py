@@ -43,20 +43,22 @@ def make_env(category: str, wrapper: PerceptionWrapperConfig | dict | None = Non
     return CaptObservationWrapper(env, wrapper)
 
 
-def run_episode(env: CaptObservationWrapper, opener: ScriptedOpener, seed: int, max_steps: int = 200,
+def run_episode(env: CaptObservationWrapper, opener: Any, seed: int, max_steps: int = 200,
                 settle_steps: int = 10) -> EpisodeResult:
-    """One episode; it ends ``settle_steps`` after the opener is done (so the part comes to rest)."""
+    """One episode of any policy with ``reset()`` and ``act(obs, info)`` (the scripted opener or a PPO
+    policy); with the scripted opener it ends ``settle_steps`` after the opener is done (so the part
+    comes to rest)."""
     obs, info = env.reset(seed=seed)
     opener.reset()
     steps, done_for = 0, 0
     for steps in range(1, max_steps + 1):  # noqa: B007
         obs, _, terminated, truncated, info = env.step(opener.act(obs, info))
-        done_for = done_for + 1 if opener.phase == Phase.DONE else 0
+        done_for = done_for + 1 if getattr(opener, "phase", None) == Phase.DONE else 0
         if done_for >= settle_steps or truncated:
             break
     obj = env.unwrapped.object
     return EpisodeResult(seed, int(obj.instance_id), bool(info["success"]), float(info["open_fraction"]),
-                         steps, opener.phase.value)
+                         steps, getattr(getattr(opener, "phase", None), "value", "policy"))
 
 
 def success_rate(category: str, seeds: list[int], wrapper: PerceptionWrapperConfig | dict | None = None,

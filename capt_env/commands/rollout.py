@@ -10,8 +10,8 @@ from capt_env.commands.json_output import write_json
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--categories", nargs="+", default=["cabinet_door"], help="object categories")
-    parser.add_argument("--policy", default="scripted", choices=["scripted"],
-                        help="policy (PPO is not implemented yet)")
+    parser.add_argument("--policy", default="scripted", choices=["scripted", "ppo"])
+    parser.add_argument("--model", default=None, help="PPO model .zip (with --policy ppo)")
     parser.add_argument("--perception", nargs="+", default=["oracle"],
                         choices=["oracle", "noisy_oracle", "capt"], help="perception sources to compare")
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
@@ -22,11 +22,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
 
 
+def _policy(args: argparse.Namespace):
+    """The policy to evaluate: the scripted opener, or a trained PPO model."""
+    if args.policy == "ppo":
+        if not args.model:
+            raise SystemExit("--policy ppo needs --model PATH (a final.zip of `capt train-ppo`)")
+        from agents.ppo.policy import PPOPolicy
+
+        return PPOPolicy.load(args.model)
+    from agents.scripted.opener import ScriptedOpener
+
+    return ScriptedOpener()
+
+
 def run(args: argparse.Namespace) -> int:
     import numpy as np
     from tqdm import tqdm
 
-    from agents.scripted.opener import ScriptedOpener
     from agents.scripted.rollout import make_env, run_episode
     from agents.success_stats import wilson_interval
 
@@ -43,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
                 obs_mode = "pointcloud"
             env = make_env(category, wrapper, obs_mode=obs_mode)
-            policy = ScriptedOpener()
+            policy = _policy(args)
             try:
                 episodes = [run_episode(env, policy, s, args.max_steps)
                             for s in tqdm(seeds, desc=f"{category} {source}")]

@@ -1,0 +1,119 @@
+"""Typed config of PPO training on joint-axis observations (YAML: ``configs/ppo/``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from capt_env.registration import CATEGORY_ENV_NAMES, MAX_EPISODE_STEPS
+from capt_env.tasks.config import TaskConfig
+from capt_env.wrappers.config import PerceptionWrapperConfig
+from perception.yaml_config import from_dict, require
+
+ObsMode = Literal["state", "pointcloud"]
+
+
+@dataclass(frozen=True)
+class PPOHyperparams:
+    """SB3 ``PPO`` hyperparameters (steps are env steps per env; rates per gradient step).
+
+    ``n_steps`` env steps per env and rollout (a rollout holds ``n_steps * n_envs`` transitions),
+    split into minibatches of ``batch_size`` for ``n_epochs`` passes. ``learning_rate`` (Adam),
+    discount ``gamma`` (per 50 ms control step), GAE ``gae_lambda``, PPO ``clip_range``, entropy
+    bonus ``ent_coef``, value loss weight ``vf_coef``, gradient norm clip ``max_grad_norm``.
+    ``net_arch``: hidden layer widths of the policy and value MLPs (separate networks, tanh).
+    """
+
+    n_steps: int = 1024
+    batch_size: int = 256
+    n_epochs: int = 10
+    learning_rate: float = 3e-4
+    gamma: float = 0.98
+    gae_lambda: float = 0.95
+    clip_range: float = 0.2
+    ent_coef: float = 0.0
+    vf_coef: float = 0.5
+    max_grad_norm: float = 0.5
+    net_arch: tuple[int, ...] = (256, 256)
+
+    def validate(self) -> None:
+        require(self.n_steps >= 2, f"ppo.n_steps must be >= 2, got {self.n_steps}")
+        require(self.batch_size >= 2, f"ppo.batch_size must be >= 2, got {self.batch_size}")
+        require(self.n_epochs >= 1, f"ppo.n_epochs must be >= 1, got {self.n_epochs}")
+        require(self.learning_rate > 0, f"ppo.learning_rate must be > 0, got {self.learning_rate}")
+        require(0 < self.gamma <= 1, f"ppo.gamma must be in (0, 1], got {self.gamma}")
+        require(0 <= self.gae_lambda <= 1, f"ppo.gae_lambda must be in [0, 1], got {self.gae_lambda}")
+        require(self.clip_range > 0, f"ppo.clip_range must be > 0, got {self.clip_range}")
+        require(self.ent_coef >= 0, f"ppo.ent_coef must be >= 0, got {self.ent_coef}")
+        require(self.vf_coef >= 0, f"ppo.vf_coef must be >= 0, got {self.vf_coef}")
+        require(self.max_grad_norm > 0, f"ppo.max_grad_norm must be > 0, got {self.max_grad_norm}")
+        require(len(self.net_arch) >= 1 and all(w >= 1 for w in self.net_arch),
+                f"ppo.net_arch must list >= 1 positive layer widths, got {list(self.net_arch)}")
+
+
+def _default_perception() -> PerceptionWrapperConfig:
+    return PerceptionWrapperConfig(source="noisy_oracle", every_k_steps=5)
+
+
+@dataclass(frozen=True)
+class PPOTrainConfig:
+    """What ``capt train-ppo`` trains: one category, one perception source, one PPO run.
+
+    Envs: ``n_envs`` CPU envs of ``category`` (``pd_ee_delta_pose``, ``obs_mode``), one process
+    each when ``n_envs > 1`` (``SubprocVecEnv``), in-process for 1 (``DummyVecEnv``), episodes cut
+    at ``max_episode_steps`` control steps (<= 200, the task's own limit). ``task`` overrides fields
+    of :class:`capt_env.tasks.TaskConfig` (placement noise, initial states, success fraction); the
+    split is always ``train`` (evaluation uses the unseen ``test`` instances).
+    ``perception``: the :class:`CaptObservationWrapper` config (source, noise, ``every_k_steps``);
+    the default is the noisy oracle every 5 steps. ``capt`` needs ``obs_mode: pointcloud``.
+
+    Training: ``total_timesteps`` env steps in all (over all envs; PPO stops at the end of the
+    rollout that reaches it), ``ppo`` hyperparameters, global ``seed``, torch ``device``
+    (``cpu`` is fastest for small MLPs), a checkpoint every ``checkpoint_every_steps`` env steps,
+    and ``normalize_obs``: running mean/std observation normalisation (``VecNormalize``, saved as
+    ``vecnormalize.pkl`` next to the model).
+    """
+
+    category: str = "laptop"
+    perception: PerceptionWrapperConfig = field(default_factory=_default_perception)
+    obs_mode: ObsMode = "state"
+    n_envs: int = 1
+    total_timesteps: int = 1_000_000
+    ppo: PPOHyperparams = field(default_factory=PPOHyperparams)
+    seed: int = 0
+    device: str = "cpu"
+    checkpoint_every_steps: int = 50_000
+    max_episode_steps: int = MAX_EPISODE_STEPS
+    task: dict[str, Any] = field(default_factory=dict)
+    normalize_obs: bool = True
+
+    def validate(self) -> None:
+        require(self.category in CATEGORY_ENV_NAMES,
+                f"category: unknown {self.category!r}; known: {sorted(CATEGORY_ENV_NAMES)}")
+        self.perception.validate()
+        require(self.perception.source != "capt" or self.obs_mode == "pointcloud",
+                "perception.source 'capt' needs obs_mode: pointcloud")
+        require(self.perception.obs_format == "flat",
+                "perception.obs_format must be 'flat' (MlpPolicy takes the 38-float Box)")
+        require(self.n_envs >= 1, f"n_envs must be >= 1, got {self.n_envs}")
+        require(self.total_timesteps >= 1, f"total_timesteps must be >= 1, got {self.total_timesteps}")
+        self.ppo.validate()
+        rollout = self.ppo.n_steps * self.n_envs
+        require(self.ppo.batch_size <= rollout,
+                f"ppo.batch_size ({self.ppo.batch_size}) must be <= ppo.n_steps * n_envs ({rollout})")
+        require(self.device in ("cpu", "cuda", "auto") or self.device.startswith("cuda:"),
+                f"device must be cpu, cuda, cuda:N or auto, got {self.device!r}")
+        require(self.checkpoint_every_steps >= 1,
+                f"checkpoint_every_steps must be >= 1, got {self.checkpoint_every_steps}")
+        require(1 <= self.max_episode_steps <= MAX_EPISODE_STEPS,
+                f"max_episode_steps must be in [1, {MAX_EPISODE_STEPS}], got {self.max_episode_steps}")
+        for key in ("category", "object", "joint"):
+            require(key not in self.task, f"task.{key}: the object is chosen by 'category', not task")
+        require(self.task.get("split", "train") == "train",
+                f"task.split must be 'train' for training (test instances are for evaluation), "
+                f"got {self.task.get('split')!r}")
+        from_dict(TaskConfig, self.train_task() | {"category": self.category}, where="task")
+
+    def train_task(self) -> dict[str, Any]:
+        """The task overrides for training envs, with the train split."""
+        return {**self.task, "split": "train"}
