@@ -18,6 +18,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--obs-modes", nargs="+", default=["state", "pointcloud"])
     parser.add_argument("--width", type=int, default=128, help="camera width and height in pixels")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--capt-every-k", type=int, nargs="*", default=[],
+                        help="also time env + CAPT perception (shipped checkpoint), run every K steps")
 
 
 def measure(category: str, obs_mode: str, steps: int, resets: int, width: int, seed: int) -> dict:
@@ -55,6 +57,31 @@ def measure(category: str, obs_mode: str, steps: int, resets: int, width: int, s
     }
 
 
+def measure_with_capt(category: str, every_k: int, steps: int, width: int, seed: int) -> dict:
+    """Steps/s of the pointcloud env wrapped with CAPT perception run every ``every_k`` steps."""
+    from agents.scripted.rollout import make_env
+    from perception.checkpoints import default_checkpoint
+
+    wrapper = {"source": "capt", "checkpoint": str(default_checkpoint(category)), "every_k_steps": every_k}
+    env = make_env(category, wrapper, obs_mode="pointcloud",
+                   task={"cameras": [{"width": width, "height": width}]})
+    env.reset(seed=seed)
+    env.action_space.seed(seed)
+    latencies = []
+    t = time.perf_counter()
+    for _ in tqdm(range(steps), desc=f"capt every {every_k}", leave=False):
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+        if info.get("perception_ran"):
+            latencies.append(float(info["perception_latency_ms"]))
+        if terminated or truncated:
+            env.reset()
+    elapsed = time.perf_counter() - t
+    env.close()
+    return {"obs_mode": "pointcloud+capt", "every_k_steps": every_k, "steps_per_second": steps / elapsed,
+            "ms_per_step": 1000 * elapsed / steps,
+            "perception_ms_median": statistics.median(latencies) if latencies else None}
+
+
 def run(args: argparse.Namespace) -> int:
     results = []
     for mode in args.obs_modes:
@@ -63,5 +90,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.category:<15} {mode:<11} {r['steps_per_second']:7.1f} steps/s "
               f"({r['ms_per_step']:.1f} ms/step)  reset {r['reset_seconds_median']:.2f} s "
               f"(first make+reset {r['first_make_and_reset_seconds']:.1f} s)")
+    for k in args.capt_every_k:
+        r = measure_with_capt(args.category, k, args.steps, args.width, args.seed)
+        results.append(r)
+        print(f"{args.category:<15} pointcloud + CAPT every {k} steps: {r['steps_per_second']:6.1f} steps/s "
+              f"({r['ms_per_step']:.1f} ms/step, perception {r['perception_ms_median']:.1f} ms)")
     write_json(args.json, {"category": args.category, "camera_pixels": args.width**2, "results": results})
     return 0
