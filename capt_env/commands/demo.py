@@ -20,7 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--category", default=None,
                         help="object category (default: every category with a shipped checkpoint)")
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
-    parser.add_argument("--episodes", type=int, default=2, help="episodes per category")
+    parser.add_argument("--episodes", type=int, default=1, help="episodes per category")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", default="outputs/demo", help="where PNGs and MP4s go")
     parser.add_argument("--no-policy", action="store_true", help="only estimate; do not open the object")
