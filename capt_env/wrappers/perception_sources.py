@@ -19,6 +19,7 @@ from capt_env.wrappers.estimate import (
     grasp_point_of_part,
     unit,
 )
+from capt_env.wrappers.estimate_fusion import EstimateFusion
 
 
 class PerceptionSource(Protocol):
@@ -92,7 +93,8 @@ class CaptSource:
 
     The checkpoint is loaded on the first call. The target joint's channel is the env's target joint
     index; the grasp point comes from the points CAPT labels as that joint's moving part (all points
-    if it labels none).
+    if it labels none). Successive estimates within an episode are fused (see ``estimate_fusion``);
+    :meth:`reset` starts a new episode.
     """
 
     needs_points = True
@@ -101,6 +103,11 @@ class CaptSource:
         self.checkpoint = checkpoint
         self.seed = seed
         self._estimator: Any = None
+        self._fusion = EstimateFusion()
+
+    def reset(self) -> None:
+        """Forget the previous episode's estimates."""
+        self._fusion.reset()
 
     def _load(self) -> Any:
         if self._estimator is None:
@@ -125,8 +132,8 @@ class CaptSource:
         direction = unit(joint.direction)
         grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
-        return JointAxisEstimate(joint.type, direction, pivot, float(joint.state), grasp,
-                                 float(joint.confidence))
+        return self._fusion.update(JointAxisEstimate(joint.type, direction, pivot, float(joint.state),
+                                                     grasp, float(joint.confidence)))
 
 
 def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: int) -> PerceptionSource:

@@ -72,6 +72,8 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             self._rng = np.random.default_rng([self.config.seed, seed])
             if hasattr(self.source, "rng"):
                 self.source.rng = np.random.default_rng([self.config.seed, seed, 1])
+        if hasattr(self.source, "reset"):
+            self.source.reset()
         self._robot_filter = None  # the robot is rebuilt on reconfiguration
         self._steps = 0
         self._estimate = None

@@ -1,0 +1,39 @@
+"""Fusing successive estimates of a static joint axis."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from capt_env.wrappers.estimate import JointAxisEstimate
+from capt_env.wrappers.estimate_fusion import EstimateFusion
+
+
+def est(direction, pivot, state=0.0, grasp=(0.3, 0.0, 0.2), confidence=1.0) -> JointAxisEstimate:
+    return JointAxisEstimate("revolute", np.asarray(direction, float), np.asarray(pivot, float), state,
+                             np.asarray(grasp, float), confidence)
+
+
+def test_flipped_and_noisy_directions_average_to_the_axis() -> None:
+    fusion = EstimateFusion()
+    fusion.update(est([0.0, 0.1, 1.0], [0.0, 0.0, 0.2]))
+    fused = fusion.update(est([0.0, 0.1, -1.0], [0.0, 0.0, 0.2]))  # sign flip, tilted the other way
+    np.testing.assert_allclose(fused.direction, [0.0, 0.0, 1.0], atol=1e-9)
+
+
+def test_pivot_and_grasp_are_weighted_means_until_the_part_moves() -> None:
+    fusion = EstimateFusion(state_tolerance=0.05)
+    fusion.update(est([0, 0, 1], [0.0, 0.0, 0.0], grasp=(0.3, 0.0, 0.2), confidence=1.0))
+    fused = fusion.update(est([0, 0, 1], [0.0, 0.09, 0.0], grasp=(0.3, 0.06, 0.2), confidence=2.0))
+    np.testing.assert_allclose(fused.grasp_point, [0.3, 0.04, 0.2], atol=1e-9)
+    np.testing.assert_allclose(fused.pivot[:2], [0.0, 0.06], atol=1e-9)  # weighted mean line
+    moved = fusion.update(est([0, 0, 1], [0.0, 0.06, 0.0], state=0.4, grasp=(0.2, 0.2, 0.2)))
+    np.testing.assert_allclose(moved.grasp_point, [0.2, 0.2, 0.2])  # the part moved: latest grasp
+    assert moved.state == 0.4
+
+
+def test_reset_forgets() -> None:
+    fusion = EstimateFusion()
+    fusion.update(est([0, 0, 1], [1.0, 0.0, 0.0]))
+    fusion.reset()
+    fused = fusion.update(est([0, 0, -1], [0.0, 0.0, 0.0]))
+    np.testing.assert_allclose(fused.direction, [0, 0, -1])
