@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import platform
 import sys
@@ -27,8 +28,19 @@ def machine_info() -> dict[str, Any]:
     return info
 
 
+def _strict(value: Any) -> Any:
+    """NaN and infinities (not valid JSON) become null; containers are converted recursively."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict(v) for v in value]
+    return value
+
+
 def write_json(path: str | os.PathLike | None, payload: dict[str, Any]) -> None:
-    """Write ``payload`` plus ``machine`` to ``path`` (no-op when path is None)."""
+    """Write ``payload`` plus ``machine`` to ``path`` as strict JSON (NaN -> null; no-op for None)."""
     if path is None:
         return
     path = Path(path)
@@ -36,7 +48,7 @@ def write_json(path: str | os.PathLike | None, payload: dict[str, Any]) -> None:
     data = {"command": " ".join(["capt", *sys.argv[1:]]), "machine": machine_info(), **payload}
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
     with os.fdopen(fd, "w") as fh:
-        json.dump(data, fh, indent=2, default=float)
+        json.dump(_strict(json.loads(json.dumps(data, default=float))), fh, indent=2, allow_nan=False)
         fh.write("\n")
     os.replace(tmp, path)
     print(f"wrote {path}")
