@@ -12,30 +12,41 @@ class ScriptedOpenerConfig:
     """Gains, offsets and targets of :class:`agents.scripted.opener.ScriptedOpener`.
 
     Approach: pre-grasp ``pregrasp_offset`` m outside the grasp point along the part's outward
-    normal, then ``grasp_depth`` m past it; the approach direction points at least ``approach_pitch``
-    rad below horizontal (a level Panda hand near the table is beyond its wrist limits). Moves are capped at
+    normal, then ``grasp_depth`` m past it. The approach direction points at least
+    ``vertical_hinge_pitch`` rad below horizontal for parts hinged about a near-vertical axis (the
+    axis within ``vertical_hinge_max_tilt`` rad of vertical: doors; the hand only yaws while
+    pulling) and ``approach_pitch`` rad for the others (drawers, oven doors, lids: the hand pitches
+    while pulling, so it starts nearer level); a level Panda hand near the table is beyond its wrist
+    limits. The fingers approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap
+    keeps a pitched fingertip off the surface a handle stands on). Moves are capped at
     ``max_step_m`` / ``max_step_rad`` per control step; ``pos_tolerance`` / ``rot_tolerance`` end
     a move, as do ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact).
-    ``close_steps`` steps close the gripper. Pulling leads the part by ``revolute_lead`` rad
-    or ``prismatic_lead`` m and stops at ``revolute_target`` rad / ``prismatic_target`` m, or when
-    the state grew by less than ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps``
-    steps (a limit, or a lost grip). The gripper
-    re-grasps (at most ``max_regrasps`` times) if it drifts more than ``slip_distance`` m from the
-    part. After release it backs off ``retreat_distance`` m.
+    ``close_steps`` steps close the gripper. Pulling leads the part by ``revolute_lead`` rad or
+    ``prismatic_lead`` m. The hand turns with a door about a vertical hinge, and by
+    ``wrist_follow`` of the part's angle about any other hinge (a grasped bar turns between the pads;
+    a hand turned fully with an oven door reaches the Panda's wrist limit). Pulling stops at
+    ``revolute_target`` rad / ``prismatic_target`` m, or when the state grew by less than
+    ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost
+    grip). The gripper re-grasps (at most ``max_regrasps`` times) if it drifts more than
+    ``slip_distance`` m from the part. After release it backs off ``retreat_distance`` m.
     """
 
     pregrasp_offset: float = 0.08
     grasp_depth: float = 0.01
-    approach_pitch: float = 0.8
+    approach_pitch: float = 0.55
+    vertical_hinge_pitch: float = 0.8
+    vertical_hinge_max_tilt: float = 0.8
     max_step_m: float = 0.03
     max_step_rad: float = 0.15
     pos_tolerance: float = 0.012
     rot_tolerance: float = 0.12
     move_timeout: int = 60
     blocked_steps: int = 6
+    approach_gap: float = 0.045
     close_steps: int = 8
     revolute_lead: float = 0.12
     prismatic_lead: float = 0.03
+    wrist_follow: float = 0.5
     revolute_target: float = 1.7
     prismatic_target: float = 0.4
     stall_progress: float = 0.02
@@ -54,5 +65,10 @@ class ScriptedOpenerConfig:
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps"):
             require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")
+        require(0.0 < self.approach_gap <= 0.08,
+                f"approach_gap must be in (0, 0.08] m, got {self.approach_gap}")
+        require(0.0 <= self.wrist_follow <= 1.0, f"wrist_follow must be in [0, 1], got {self.wrist_follow}")
         require(self.max_regrasps >= 0, "max_regrasps must be >= 0")
-        require(0 <= self.approach_pitch <= 1.5, "approach_pitch must be in [0, 1.5] rad")
+        for key in ("approach_pitch", "vertical_hinge_pitch", "vertical_hinge_max_tilt"):
+            value = getattr(self, key)
+            require(0 <= value <= 1.5, f"{key} must be in [0, 1.5] rad, got {value}")

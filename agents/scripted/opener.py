@@ -13,8 +13,9 @@ Strategy, per episode:
    part's outward normal ``n`` (revolute: the opening direction of the grasp point,
    ``axis x (grasp - pivot)``; prismatic: the axis), with the TCP approach axis along ``-n`` and the
    fingers closing perpendicular to the handle (revolute: along the radius from the axis, so a bar
-   parallel to the hinge is enclosed; prismatic: vertically). The approach is pitched at least
-   ``approach_pitch`` below horizontal (the Panda's wrist cannot point level near the table).
+   parallel to the hinge is enclosed; prismatic: vertically). The approach is pitched below
+   horizontal by at least ``vertical_hinge_pitch`` (doors) or ``approach_pitch`` (other parts), as
+   the Panda's wrist cannot point level near the table.
 2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper.
 4. ``PULL``: the target TCP pose is the grasp pose moved with the part to state
    ``state_now + lead``: rotated about the estimated axis (revolute) or shifted along it
@@ -50,6 +51,14 @@ ACTION_SCALE_M = 0.1  # pd_ee_delta_pose: metres per unit translation action
 # so a unit rotation action turns by -0.1 rad (XYZ Euler ~ rotation vector at these small angles).
 ACTION_SCALE_RAD = -0.1
 _UP = np.array([0.0, 0.0, 1.0])
+# ManiSkill's Panda gripper maps action [-1, 1] linearly to each finger's position [-0.01, 0.04] m.
+_FINGER_LOW, _FINGER_HIGH = -0.01, 0.04
+
+
+def gripper_action(gap: float) -> float:
+    """Gripper action in [-1, 1] that holds the fingers ``gap`` metres apart."""
+    finger = 0.5 * gap
+    return float(np.clip(2.0 * (finger - _FINGER_LOW) / (_FINGER_HIGH - _FINGER_LOW) - 1.0, -1.0, 1.0))
 
 
 class Phase(enum.Enum):
@@ -70,6 +79,13 @@ def outward_normal(est: JointAxisEstimate) -> np.ndarray:
     return unit(np.cross(u, est.grasp_point - est.pivot))
 
 
+def is_vertical_hinge(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
+    """Whether ``est`` is a revolute joint whose axis is within ``vertical_hinge_max_tilt`` of vertical."""
+    if est.joint_type != "revolute":
+        return False
+    return abs(float(unit(est.direction)[2])) >= float(np.cos(cfg.vertical_hinge_max_tilt))
+
+
 def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig) -> np.ndarray:
     """TCP rotation (3, 3) for grasping: approach along -n, fingers closing across the handle.
 
@@ -87,13 +103,14 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
     frame = grasp_frame(approach, closing)
     elevation = float(np.arcsin(np.clip(approach[2], -1.0, 1.0)))
     horizontal = perpendicular(approach, _UP)
-    if elevation > -cfg.approach_pitch and horizontal is not None:
+    pitch = cfg.vertical_hinge_pitch if is_vertical_hinge(est, cfg) else cfg.approach_pitch
+    if elevation > -pitch and horizontal is not None:
         # point the hand down by turning about the horizontal axis across the approach: the Panda's
         # wrist cannot point level at table height, and a handle bar stays between the fingers
         # (the bar is either along that axis or perpendicular to the closing direction)
         side = np.cross(approach, _UP)
         side = side / np.linalg.norm(side)
-        rot = axis_angle_matrix(side, -(elevation + cfg.approach_pitch))
+        rot = axis_angle_matrix(side, -(elevation + pitch))
         if (rot @ approach)[2] > approach[2]:
             rot = rot.T
         frame = rot @ frame
@@ -175,7 +192,7 @@ class ScriptedOpener:
                 goal = est.grasp_point - approach * cfg.pregrasp_offset
             else:
                 goal = est.grasp_point + approach * cfg.grasp_depth
-            action, perr, rerr = self._goto(p, r, goal, self._target_r, GRIPPER_OPEN)
+            action, perr, rerr = self._goto(p, r, goal, self._target_r, gripper_action(cfg.approach_gap))
             if self._reached(p, perr, rerr):
                 self._set(Phase.APPROACH if self.phase == Phase.PREGRASP else Phase.CLOSE)
             return action
@@ -236,9 +253,9 @@ class ScriptedOpener:
         u = unit(est.direction)
         if revolute:
             delta = est.state - self._grasp_state + cfg.revolute_lead
-            rot = axis_angle_matrix(u, delta)
-            p_des = est.pivot + rot @ (self._grasp_p - est.pivot)
-            r_des = rot @ self._grasp_r
+            p_des = est.pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - est.pivot)
+            follow = 1.0 if is_vertical_hinge(est, cfg) else cfg.wrist_follow
+            r_des = axis_angle_matrix(u, follow * delta) @ self._grasp_r
         else:
             delta = est.state - self._grasp_state + cfg.prismatic_lead
             p_des = self._grasp_p + u * delta

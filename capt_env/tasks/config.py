@@ -63,6 +63,8 @@ class TaskConfig:
 
     Joint states at reset: the target joint starts at a fraction of its range uniform in
     ``target_init_fraction``; other joints uniform in ``other_init_fraction`` of their ranges.
+    Both default to nearly closed (as in ManiSkill's OpenCabinet tasks): an open drawer above the
+    target one reaches into the Panda's wrist at reset. Data generation opens everything at random.
 
     Success: the target joint is opened past ``success_fraction`` of its range and at rest
     (child link speed below ``rest_linear_speed`` m/s and ``rest_angular_speed`` rad/s).
@@ -78,7 +80,7 @@ class TaskConfig:
     object_xy_noise: tuple[float, float] = (0.05, 0.05)
     yaw_noise: float = 0.2
     target_init_fraction: tuple[float, float] = (0.0, 0.05)
-    other_init_fraction: tuple[float, float] = (0.0, 1.0)
+    other_init_fraction: tuple[float, float] = (0.0, 0.05)
     success_fraction: float = 0.75
     rest_linear_speed: float = 0.1
     rest_angular_speed: float = 1.0
