@@ -22,7 +22,9 @@ Strategy, per episode:
    (prismatic); the estimate is re-read every step, so re-estimation corrects the path.
 5. ``RELEASE`` when the estimated state reaches the target (or stops growing: a limit), open, and
    ``RETREAT`` along the outward normal; then ``DONE`` (hold still, gripper open).
-If the TCP drifts from the part's grasp point while pulling, it goes back to 1 (bounded re-grasps).
+If the TCP drifts from the part's grasp point while pulling, it goes back to 1; if pulling stalls short
+of the target (a slipping grip, or the arm's range), it releases, retreats and goes back to 1 from
+the part's new pose (re-grasps are bounded by ``max_regrasps``).
 """
 
 from __future__ import annotations
@@ -143,6 +145,7 @@ class ScriptedOpener:
         self._target_r: np.ndarray | None = None
         self._history: list[float] = []
         self._retreat_from: np.ndarray | None = None
+        self._grasp_again = False
         self._still = 0
         self._last_p: np.ndarray | None = None
         self._last_err = (0.0, 0.0)
@@ -222,7 +225,12 @@ class ScriptedOpener:
             goal = self._retreat_from - r[:, 2] * cfg.retreat_distance
             action, perr, _ = self._goto(p, r, goal, r, GRIPPER_OPEN)
             if perr < cfg.pos_tolerance or self.phase_steps >= cfg.move_timeout:
-                self._set(Phase.DONE)
+                if self._grasp_again:
+                    self._grasp_again = False
+                    self._target_r = None
+                    self._set(Phase.PREGRASP)
+                else:
+                    self._set(Phase.DONE)
             return action
 
         action = np.zeros(7, np.float32)
@@ -239,6 +247,9 @@ class ScriptedOpener:
         stalled = (len(self._history) > cfg.stall_steps
                    and self._history[-1] - self._history[-1 - cfg.stall_steps] < min_progress)
         if est.state >= target or stalled:
+            # short of the target the grip slipped or the arm ran out of range: grasp again from here
+            self._grasp_again = est.state < target and self.regrasps < cfg.max_regrasps
+            self.regrasps += int(self._grasp_again)
             self._set(Phase.RELEASE)
             action = np.zeros(7, np.float32)
             action[6] = GRIPPER_CLOSE
