@@ -9,7 +9,7 @@ estimate cannot produce large motions, and the same actions work with CPU and GP
 
 Strategy, per episode:
 
-1. ``PREGRASP``: open the gripper and move to ``pregrasp_offset`` outside the grasp point along the
+1. ``PREGRASP``: open the gripper to ``approach_gap`` and move to ``pregrasp_offset`` outside the grasp point along the
    part's outward normal ``n`` (revolute: the opening direction of the grasp point,
    ``axis x (grasp - pivot)``; prismatic: the axis), with the TCP approach axis along ``-n`` and the
    fingers closing perpendicular to the handle (revolute: along the radius from the axis, so a bar
@@ -17,9 +17,10 @@ Strategy, per episode:
    horizontal by at least ``vertical_hinge_pitch`` (doors) or ``approach_pitch`` (other parts), as
    the Panda's wrist cannot point level near the table.
 2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper.
-4. ``PULL``: the target TCP pose is the grasp pose moved with the part to state
+4. ``PULL``: the target TCP position is the grasp position moved with the part to state
    ``state_now + lead``: rotated about the estimated axis (revolute) or shifted along it
-   (prismatic); the estimate is re-read every step, so re-estimation corrects the path.
+   (prismatic); the hand turns fully with a door on a vertical hinge and by ``wrist_follow`` of the
+   angle about other hinges. The estimate is re-read every step, so re-estimation corrects the path.
 5. ``RELEASE`` when the estimated state reaches the target (or stops growing: a limit), open, and
    ``RETREAT`` along the outward normal; then ``DONE`` (hold still, gripper open).
 If the TCP drifts from the part's grasp point while pulling, it goes back to 1; if pulling stalls short
