@@ -9,8 +9,8 @@ estimate cannot produce large motions, and the same actions work with CPU and GP
 
 Strategy, per episode:
 
-1. ``PREGRASP``: open the gripper to ``approach_gap`` and move to ``pregrasp_offset`` outside the grasp point along the
-   part's outward normal ``n`` (revolute: the opening direction of the grasp point,
+1. ``PREGRASP``: open the gripper to ``approach_gap`` and move to ``pregrasp_offset`` outside the
+   grasp point along the part's outward normal ``n`` (revolute: the opening direction of the grasp point,
    ``axis x (grasp - pivot)``; prismatic: the axis), with the TCP approach axis along ``-n`` and the
    fingers closing perpendicular to the handle (revolute: along the radius from the axis, so a bar
    parallel to the hinge is enclosed; prismatic: vertically). The approach is pitched below
