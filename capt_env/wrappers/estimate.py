@@ -1,8 +1,8 @@
 """The joint-axis estimate of the target joint, world frame, as the observation and the agents see it.
 
 Also the two canonical choices an estimate needs: the pivot (the point of the axis closest to the
-grasp point) and the grasp point of a moving part's points (far edge from a revolute axis, or the
-front-most point along a prismatic axis).
+grasp point) and the grasp point of a moving part: its handle when one stands off the part's plane,
+else the far edge from a revolute axis or the front-most points along a prismatic axis.
 """
 
 from __future__ import annotations
@@ -48,6 +48,37 @@ def unit(v: np.ndarray) -> np.ndarray:
     if n < 1e-9:
         raise ValueError("cannot normalise a zero vector")
     return np.asarray(v, dtype=np.float64) / n
+
+
+def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standoff: float = 0.012,
+                 max_standoff: float = 0.08, margin: float = 0.1, min_points: int = 3) -> np.ndarray | None:
+    """Centre (3,) of a handle standing off a flat moving part, or None; world frame, metres.
+
+    The part's plane is fitted to ``part_points`` (M, 3) by PCA, its offset the median (robust to a
+    few mislabelled points), and its normal turned away from the rest of the object (a door, drawer
+    front or lid lies on the outside of its body). The handle is the ``object_points`` (N, 3) (all
+    of the object's points: a segmentation may miss thin handle points) between ``min_standoff``
+    and ``max_standoff`` m outside that plane and within the part's in-plane extent grown by
+    ``margin`` m (a view may show only some of the part). None when fewer than ``min_points``
+    qualify or the part is not flat.
+    """
+    if len(part_points) < 10 or len(object_points) < min_points:
+        return None
+    centre = part_points.mean(axis=0)
+    _, sv, vt = np.linalg.svd(part_points - centre, full_matrices=False)
+    if sv[2] > 0.5 * sv[1]:
+        return None
+    normal = vt[2]
+    plane = float(np.median((part_points - centre) @ normal))
+    if float((object_points.mean(axis=0) - centre) @ normal) > plane:
+        normal, plane = -normal, -plane
+    standoff = (object_points - centre) @ normal - plane
+    in_plane = (part_points - centre) @ vt[:2].T
+    lo, hi = in_plane.min(axis=0) - margin, in_plane.max(axis=0) + margin
+    uv = (object_points - centre) @ vt[:2].T
+    keep = ((standoff > min_standoff) & (standoff < max_standoff)
+            & np.all(uv >= lo, axis=1) & np.all(uv <= hi, axis=1))
+    return object_points[keep].mean(axis=0) if int(keep.sum()) >= min_points else None
 
 
 def grasp_point_of_part(part_points: np.ndarray, joint_type: str, direction: np.ndarray,

@@ -17,6 +17,7 @@ from capt_env.wrappers.estimate import (
     JointAxisEstimate,
     canonical_pivot,
     grasp_point_of_part,
+    handle_point,
     unit,
 )
 from capt_env.wrappers.estimate_fusion import EstimateFusion
@@ -92,8 +93,9 @@ class CaptSource:
     """CAPT (``perception.inference.ArticulationEstimator``) on the isolated object points.
 
     The checkpoint is loaded on the first call. The target joint's channel is the env's target joint
-    index; the grasp point comes from the points CAPT labels as that joint's moving part (all points
-    if it labels none). Successive estimates within an episode are fused (see ``estimate_fusion``);
+    index; the grasp point is the handle standing off the plane of the points CAPT labels as that
+    joint's moving part (``handle_point``), else the far edge of those points (all points if it
+    labels none). Successive estimates within an episode are fused (see ``estimate_fusion``);
     :meth:`reset` starts a new episode.
     """
 
@@ -130,7 +132,9 @@ class CaptSource:
             if mask.sum() >= 3:
                 moving = points[mask]
         direction = unit(joint.direction)
-        grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
+        grasp = handle_point(points, moving)
+        if grasp is None:
+            grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
         return self._fusion.update(JointAxisEstimate(joint.type, direction, pivot, float(joint.state),
                                                      grasp, float(joint.confidence)))

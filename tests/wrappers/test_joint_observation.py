@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part
+from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part, handle_point
 from capt_env.wrappers.joint_observation import (
     OBSERVATION_SIZE,
     build_dict,
@@ -59,3 +59,28 @@ def test_canonical_pivot_and_far_edge_grasp_point() -> None:
     assert g[0] > 0.38  # the edge far from the hinge at x = 0
     g = grasp_point_of_part(door, "prismatic", np.array([1.0, 0.0, 0.0]), np.zeros(3))
     assert g[0] > 0.38
+
+
+def _oven_like_scene(rng: np.random.Generator, with_handle: bool) -> tuple[np.ndarray, np.ndarray]:
+    """A door in the plane x = 0 (y in [-0.2, 0.2], z in [0, 0.4]) on a body behind it (x > 0), and
+    optionally a bar handle 3 cm in front of the door (x = -0.03) at z = 0.35, y in [-0.1, 0.1]."""
+    door = np.stack([np.zeros(800), rng.uniform(-0.2, 0.2, 800), rng.uniform(0.0, 0.4, 800)], axis=1)
+    body = np.stack([rng.uniform(0.02, 0.4, 800), rng.uniform(-0.2, 0.2, 800), np.full(800, 0.45)], axis=1)
+    parts = [door, body]
+    if with_handle:
+        parts.append(np.stack([np.full(40, -0.03), rng.uniform(-0.1, 0.1, 40), np.full(40, 0.35)], axis=1))
+    return np.concatenate(parts), door
+
+
+def test_handle_point_finds_the_bar_in_front_of_the_door_plane() -> None:
+    rng = np.random.default_rng(1)
+    cloud, door = _oven_like_scene(rng, with_handle=True)
+    h = handle_point(cloud, door[door[:, 1] < 0])  # a segmentation that labels only half the door
+    assert h is not None
+    np.testing.assert_allclose(h, [-0.03, 0.0, 0.35], atol=0.02)
+    # no handle: nothing stands off the outer side (the body lies behind the door)
+    cloud, door = _oven_like_scene(rng, with_handle=False)
+    assert handle_point(cloud, door) is None
+    # a part that is not flat has no plane to stand off
+    blob = rng.normal(size=(200, 3)) * 0.1
+    assert handle_point(blob, blob) is None
