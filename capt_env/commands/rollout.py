@@ -19,6 +19,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
     parser.add_argument("--every-k-steps", type=int, default=5, help="perception period in env steps")
     parser.add_argument("--max-steps", type=int, default=200)
+    parser.add_argument("--task", default=None,
+                        help="YAML of TaskConfig overrides for every category (cameras, placement, ...), "
+                             "e.g. configs/tasks/two_cameras.yaml; no category/object key")
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
 
 
@@ -35,6 +38,22 @@ def _policy(args: argparse.Namespace):
     return ScriptedOpener()
 
 
+def task_overrides(path: str | None) -> dict:
+    """TaskConfig keys from a YAML file, applied to every category (validated when the env is made)."""
+    if path is None:
+        return {}
+    import yaml
+
+    with open(path) as fh:
+        raw = yaml.safe_load(fh) or {}
+    if not isinstance(raw, dict):
+        raise SystemExit(f"--task {path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
+    clash = sorted({"category", "object"} & set(raw))
+    if clash:
+        raise SystemExit(f"--task {path}: {clash} would override --categories; remove them")
+    return raw
+
+
 def run(args: argparse.Namespace) -> int:
     import numpy as np
     from tqdm import tqdm
@@ -45,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
     header = "| category | perception | success | 95% interval | mean opened | mean steps | episodes |"
     rows, lines = [], [header, "| --- | --- | --- | --- | --- | --- | --- |"]
     seeds = list(range(args.first_seed, args.first_seed + args.episodes))
+    task = task_overrides(args.task)
     for category in args.categories:
         for source in args.perception:
             wrapper = {"source": source, "every_k_steps": args.every_k_steps}
@@ -54,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
 
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
                 obs_mode = "pointcloud"
-            env = make_env(category, wrapper, obs_mode=obs_mode)
+            env = make_env(category, wrapper, task=task, obs_mode=obs_mode)
             policy = _policy(args)
             try:
                 episodes = [run_episode(env, policy, s, args.max_steps)
@@ -79,5 +99,5 @@ def run(args: argparse.Namespace) -> int:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
         Path(args.markdown).write_text(table + "\n")
     write_json(args.json, {"seeds": seeds, "policy": args.policy, "max_steps": args.max_steps,
-                           "every_k_steps": args.every_k_steps, "results": rows})
+                           "every_k_steps": args.every_k_steps, "task": task, "results": rows})
     return 0

@@ -38,3 +38,19 @@ def test_bench_writes_numbers(tmp_path: Path) -> None:
                  "--obs-modes", "state", "--json", str(out)]) == 0
     result = json.loads(out.read_text())["results"][0]
     assert result["obs_mode"] == "state" and result["steps_per_second"] > 0
+
+
+def test_rollout_task_overrides_load_and_reject_a_category(tmp_path: Path) -> None:
+    from capt_env.commands.rollout import task_overrides
+    from capt_env.tasks.config import TaskConfig
+    from perception.yaml_config import from_dict
+
+    repo = Path(__file__).resolve().parents[2]
+    task = task_overrides(str(repo / "configs/tasks/two_cameras.yaml"))
+    cfg = from_dict(TaskConfig, {"category": "oven", **task}, where="task")
+    assert [c.name for c in cfg.cameras] == ["left_camera", "right_camera"]
+    assert task_overrides(None) == {}
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("category: oven\n")
+    with pytest.raises(SystemExit, match="category"):
+        task_overrides(str(bad))

@@ -84,3 +84,19 @@ def test_handle_point_finds_the_bar_in_front_of_the_door_plane() -> None:
     # a part that is not flat has no plane to stand off
     blob = rng.normal(size=(200, 3)) * 0.1
     assert handle_point(blob, blob) is None
+
+
+def test_handle_point_survives_mislabelled_body_points_surface_noise_and_uneven_density() -> None:
+    rng = np.random.default_rng(2)
+    door = np.stack([np.zeros(800), rng.uniform(-0.2, 0.2, 800), rng.uniform(0.0, 0.4, 800)], axis=1)
+    body = np.stack([rng.uniform(0.02, 0.4, 800), rng.uniform(-0.2, 0.2, 800), np.full(800, 0.45)], axis=1)
+    # surface noise: a patch of the door's lower half just above min_standoff (1.3 cm) off its plane
+    bump = np.stack([np.full(60, -0.013), rng.uniform(-0.2, 0.2, 60), rng.uniform(0.0, 0.15, 60)], axis=1)
+    # the bar (y in [-0.1, 0.1]) seen densely on one side only, as when the hand hides the other side
+    bar_y = np.concatenate([rng.uniform(-0.1, 0.0, 60), rng.uniform(0.0, 0.1, 8)])
+    bar = np.stack([np.full(len(bar_y), -0.03), bar_y, np.full(len(bar_y), 0.35)], axis=1)
+    cloud = np.concatenate([door, body, bump, bar])
+    part = np.concatenate([door, bump, body[:80]])  # a segmentation that also takes some of the body
+    h = handle_point(cloud, part)
+    assert h is not None
+    np.testing.assert_allclose(h, [-0.03, 0.0, 0.35], atol=0.02)
