@@ -27,8 +27,10 @@ class ScriptedOpenerConfig:
     a hand turned fully with an oven door reaches the Panda's wrist limit). Pulling stops at
     ``revolute_target`` rad / ``prismatic_target`` m, or when the state grew by less than
     ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost
-    grip). The gripper re-grasps (at most ``max_regrasps`` times) if it drifts more than
-    ``slip_distance`` m from the part. After release it backs off ``retreat_distance`` m.
+    grip). The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than
+    ``slip_distance`` m from the part's perceived grasp point for ``slip_steps`` steps (longer than
+    the perception period, so one bad estimate, e.g. of a handle the hand now hides, is not a slip).
+    After release it backs off ``retreat_distance`` m.
     """
 
     pregrasp_offset: float = 0.08
@@ -53,6 +55,7 @@ class ScriptedOpenerConfig:
     stall_progress_m: float = 0.004
     stall_steps: int = 12
     slip_distance: float = 0.07
+    slip_steps: int = 8
     max_regrasps: int = 2
     retreat_distance: float = 0.08
     release_steps: int = 6
@@ -63,7 +66,8 @@ class ScriptedOpenerConfig:
                     "revolute_target", "prismatic_target",
                     "slip_distance"):
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
-        for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps"):
+        for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",
+                    "slip_steps"):
             require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")
         require(0.0 < self.approach_gap <= 0.08,
                 f"approach_gap must be in (0, 0.08] m, got {self.approach_gap}")

@@ -37,3 +37,16 @@ def clip_norm(v: np.ndarray, max_norm: float) -> np.ndarray:
     """``v`` scaled down to norm ``max_norm`` if longer."""
     n = float(np.linalg.norm(v))
     return v if n <= max_norm else v * (max_norm / n)
+
+
+def swept_angle(axis: np.ndarray, pivot: np.ndarray, start: np.ndarray, now: np.ndarray) -> float:
+    """Signed angle (radians, right-handed about unit ``axis``) that carries point ``start`` (3,) to
+    point ``now`` (3,) about the line through ``pivot`` (3,); components along the axis are ignored.
+    0 when either point lies on the line."""
+    a = np.asarray(start, dtype=np.float64) - pivot
+    b = np.asarray(now, dtype=np.float64) - pivot
+    a = a - float(a @ axis) * axis
+    b = b - float(b @ axis) * axis
+    if np.linalg.norm(a) < 1e-6 or np.linalg.norm(b) < 1e-6:
+        return 0.0
+    return float(np.arctan2(float(np.cross(a, b) @ axis), float(a @ b)))

@@ -17,15 +17,18 @@ Strategy, per episode:
    horizontal by at least ``vertical_hinge_pitch`` (doors) or ``approach_pitch`` (other parts), as
    the Panda's wrist cannot point level near the table.
 2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper.
-4. ``PULL``: the target TCP position is the grasp position moved with the part to state
-   ``state_now + lead``: rotated about the estimated axis (revolute) or shifted along it
-   (prismatic); the hand turns fully with a door on a vertical hinge and by ``wrist_follow`` of the
-   angle about other hinges. The estimate is re-read every step, so re-estimation corrects the path.
-5. ``RELEASE`` when the estimated state reaches the target (or stops growing: a limit), open, and
+4. ``PULL``: the part's state is measured by the hand itself while it holds the part (the grasp-time
+   estimate plus the TCP's swept angle about the estimated axis, or its travel along it), every
+   step and free of the perceived state's noise. The target TCP position is the grasp position moved
+   with the part to state ``state_now + lead``: rotated about the estimated axis (revolute) or
+   shifted along it (prismatic); the hand turns fully with a door on a vertical hinge and by
+   ``wrist_follow`` of the angle about other hinges. The estimate is re-read every step, so
+   re-estimation corrects the path.
+5. ``RELEASE`` when that state reaches the target (or stops growing: a limit), open, and
    ``RETREAT`` along the outward normal; then ``DONE`` (hold still, gripper open).
-If the TCP drifts from the part's grasp point while pulling, it goes back to 1; if pulling stalls short
-of the target (a slipping grip, or the arm's range), it releases, retreats and goes back to 1 from
-the part's new pose (re-grasps are bounded by ``max_regrasps``).
+If the TCP stays away from the part's grasp point for ``slip_steps`` while pulling, it goes back to
+1; if pulling stalls short of the target (a slipping grip, or the arm's range), it releases, retreats
+and goes back to 1 from the part's new pose (re-grasps are bounded by ``max_regrasps``).
 """
 
 from __future__ import annotations
@@ -43,6 +46,7 @@ from agents.scripted.geometry import (
     perpendicular,
     quat_to_matrix,
     rotation_error,
+    swept_angle,
 )
 from capt_env.wrappers.estimate import JointAxisEstimate, unit
 from capt_env.wrappers.joint_observation import decode_observation
@@ -145,6 +149,7 @@ class ScriptedOpener:
         self._grasp_state = 0.0
         self._target_r: np.ndarray | None = None
         self._history: list[float] = []
+        self._slip_count = 0
         self._retreat_from: np.ndarray | None = None
         self._grasp_again = False
         self._still = 0
@@ -207,6 +212,7 @@ class ScriptedOpener:
             if self.phase_steps >= cfg.close_steps:
                 self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
                 self._history = []
+                self._slip_count = 0
                 self._set(Phase.PULL)
             return action
 
@@ -241,35 +247,43 @@ class ScriptedOpener:
     def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray) -> np.ndarray:
         cfg = self.cfg
         assert self._grasp_p is not None and self._grasp_r is not None
-        self._history.append(est.state)
         revolute = est.joint_type == "revolute"
+        u = unit(est.direction)
+        # while the hand holds the part, its own travel along the estimated arc or line measures the
+        # part's state every step; the perceived state is noisier and only as fresh as the last estimate
+        if revolute:
+            state = self._grasp_state + swept_angle(u, est.pivot, self._grasp_p, p)
+        else:
+            state = self._grasp_state + float((p - self._grasp_p) @ u)
+        self._history.append(state)
         target = cfg.revolute_target if revolute else cfg.prismatic_target
         min_progress = cfg.stall_progress if revolute else cfg.stall_progress_m
         stalled = (len(self._history) > cfg.stall_steps
                    and self._history[-1] - self._history[-1 - cfg.stall_steps] < min_progress)
-        if est.state >= target or stalled:
+        if state >= target or stalled:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
-            self._grasp_again = est.state < target and self.regrasps < cfg.max_regrasps
+            self._grasp_again = state < target and self.regrasps < cfg.max_regrasps
             self.regrasps += int(self._grasp_again)
             self._set(Phase.RELEASE)
             action = np.zeros(7, np.float32)
             action[6] = GRIPPER_CLOSE
             return action
-        if np.linalg.norm(p - est.grasp_point) > cfg.slip_distance and self.regrasps < cfg.max_regrasps:
+        far = np.linalg.norm(p - est.grasp_point) > cfg.slip_distance
+        self._slip_count = self._slip_count + 1 if far else 0
+        if self._slip_count >= cfg.slip_steps and self.regrasps < cfg.max_regrasps:
             self.regrasps += 1
             self._target_r = None
             self._set(Phase.PREGRASP)
             action = np.zeros(7, np.float32)
             action[6] = GRIPPER_OPEN
             return action
-        u = unit(est.direction)
         if revolute:
-            delta = est.state - self._grasp_state + cfg.revolute_lead
+            delta = state - self._grasp_state + cfg.revolute_lead
             p_des = est.pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - est.pivot)
             follow = 1.0 if is_vertical_hinge(est, cfg) else cfg.wrist_follow
             r_des = axis_angle_matrix(u, follow * delta) @ self._grasp_r
         else:
-            delta = est.state - self._grasp_state + cfg.prismatic_lead
+            delta = state - self._grasp_state + cfg.prismatic_lead
             p_des = self._grasp_p + u * delta
             r_des = self._grasp_r
         action, _, _ = self._goto(p, r, p_des, r_des, GRIPPER_CLOSE)

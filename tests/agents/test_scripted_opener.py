@@ -7,6 +7,7 @@ import pytest
 
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
+from agents.scripted.geometry import axis_angle_matrix, swept_angle
 from agents.scripted.opener import outward_normal
 from agents.scripted.rollout import make_env, run_episode
 from capt_env.wrappers.estimate import JointAxisEstimate
@@ -18,6 +19,15 @@ def test_outward_normal_of_a_door_points_at_the_robot() -> None:
     est = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]), 0.0,
                             np.array([-0.1, 0.2, 0.3]))
     np.testing.assert_allclose(outward_normal(est), [-1.0, 0.0, 0.0], atol=1e-9)
+
+
+def test_swept_angle_is_signed_and_ignores_travel_along_the_axis() -> None:
+    axis, pivot = np.array([0.0, 0.0, 1.0]), np.array([0.5, -0.2, 0.0])
+    start = pivot + np.array([0.0, 0.4, 0.3])
+    for angle in (0.3, -1.2, 2.5):
+        now = pivot + axis_angle_matrix(axis, angle) @ (start - pivot) + np.array([0.0, 0.0, 0.1])
+        assert swept_angle(axis, pivot, start, now) == pytest.approx(angle, abs=1e-9)
+    assert swept_angle(axis, pivot, start, pivot + np.array([0.0, 0.0, 0.2])) == 0.0
 
 
 def test_bad_opener_config_is_rejected() -> None:
