@@ -124,6 +124,21 @@ def choose_window_on(model: CaptModel, dataset: CaptShardDataset, config: TrainC
     return w0, w1
 
 
+def extend_cosine_schedule(optimizer: torch.optim.Optimizer,
+                           scheduler: torch.optim.lr_scheduler.CosineAnnealingLR, epochs: int) -> None:
+    """Re-plan a resumed cosine schedule over ``epochs`` in all (a run given more epochs than it
+    started with): the learning rate jumps to the closed-form cosine value at the epochs already done.
+
+    Setting ``T_max`` alone is not enough: the scheduler steps its last learning rate recursively, so a
+    run that reached the end of its first plan (learning rate 0) would stay at 0.
+    """
+    scheduler.T_max = epochs
+    factor = (1 + math.cos(math.pi * scheduler.last_epoch / epochs)) / 2
+    for group, base in zip(optimizer.param_groups, scheduler.base_lrs, strict=True):
+        group["lr"] = scheduler.eta_min + (base - scheduler.eta_min) * factor
+    scheduler._last_lr = [group["lr"] for group in optimizer.param_groups]
+
+
 def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume: bool = True,
           stop_after: int | None = None) -> TrainResult:
     """Train ``config.model`` on ``data_dir`` (shard layout of :mod:`perception.data`) into ``out_dir``.
@@ -159,7 +174,8 @@ def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume
         model.load_state_dict(ckpt.state_dict)
         optimizer.load_state_dict(ckpt.extra["optimizer"])
         scheduler.load_state_dict(ckpt.extra["scheduler"])
-        scheduler.T_max = config.epochs  # a resumed run may have been given more epochs
+        if scheduler.T_max != config.epochs:
+            extend_cosine_schedule(optimizer, scheduler, config.epochs)
         start_epoch = int(ckpt.extra["epoch"]) + 1
         best_val = float(ckpt.extra["best_val"])
         torch.set_rng_state(ckpt.extra["torch_rng"])

@@ -1,8 +1,9 @@
 """The joint-axis estimate of the target joint, world frame, as the observation and the agents see it.
 
 Also the two canonical choices an estimate needs: the pivot (the point of the axis closest to the
-grasp point) and the grasp point of a moving part: its handle when one stands off the part's plane,
-else the far edge from a revolute axis or the front-most points along a prismatic axis.
+grasp point) and the fallback grasp point of a moving part (the far edge from a revolute axis or the
+front-most points along a prismatic axis); the handle and the opening sign come from the part's
+geometry in ``moving_part_geometry``.
 """
 
 from __future__ import annotations
@@ -48,73 +49,6 @@ def unit(v: np.ndarray) -> np.ndarray:
     if n < 1e-9:
         raise ValueError("cannot normalise a zero vector")
     return np.asarray(v, dtype=np.float64) / n
-
-
-def dominant_plane_inliers(points: np.ndarray, tolerance: float = 0.01, trials: int = 64,
-                           seed: int = 0) -> np.ndarray:
-    """Mask (M,) of the ``points`` (M, 3) within ``tolerance`` m of the plane through most of them.
-
-    RANSAC over ``trials`` planes through three points drawn with a fixed ``seed`` (deterministic).
-    """
-    rng = np.random.default_rng(seed)
-    best = np.zeros(len(points), dtype=bool)
-    if len(points) < 3:
-        return best
-    for _ in range(trials):
-        a, b, c = points[rng.choice(len(points), 3, replace=False)]
-        n = np.cross(b - a, c - a)
-        norm = np.linalg.norm(n)
-        if norm < 1e-9:
-            continue
-        inliers = np.abs((points - a) @ (n / norm)) < tolerance
-        if inliers.sum() > best.sum():
-            best = inliers
-    return best
-
-
-def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standoff: float = 0.012,
-                 max_standoff: float = 0.08, margin: float = 0.1, min_points: int = 3) -> np.ndarray | None:
-    """Centre (3,) of a handle standing off a flat moving part, or None; world frame, metres.
-
-    The part's plane is the plane through most of ``part_points`` (M, 3) (``dominant_plane_inliers``,
-    refitted by PCA to those inliers: a segmentation's mislabelled body points would tilt a plain
-    fit), its normal turned away from the rest of the object (a door, drawer front or lid lies on
-    the outside of its body). The handle is the ``object_points`` (N, 3) (all
-    of the object's points: a segmentation may miss thin handle points) between ``min_standoff``
-    and ``max_standoff`` m outside that plane and within the part's in-plane extent grown by
-    ``margin`` m (a view may show only some of the part), keeping those standing at least half as
-    far out as the outermost ones (a bar, not the part's own surface noise); the point returned is
-    their centroid moved, along their main direction, to the middle of their extent. None when
-    fewer than ``min_points`` qualify or no plane holds half of the part's points (not flat).
-    """
-    if len(part_points) < 10 or len(object_points) < min_points:
-        return None
-    near = dominant_plane_inliers(part_points)
-    if int(near.sum()) < max(10, len(part_points) // 2):
-        return None  # no plane holds most of the part: it is not flat
-    centre = part_points[near].mean(axis=0)
-    vt = np.linalg.svd(part_points[near] - centre, full_matrices=False)[2]
-    normal = vt[2]
-    if float((object_points.mean(axis=0) - centre) @ normal) > 0.0:
-        normal = -normal
-    standoff = (object_points - centre) @ normal
-    in_plane = (part_points - centre) @ vt[:2].T
-    lo, hi = in_plane.min(axis=0) - margin, in_plane.max(axis=0) + margin
-    uv = (object_points - centre) @ vt[:2].T
-    keep = ((standoff > min_standoff) & (standoff < max_standoff)
-            & np.all(uv >= lo, axis=1) & np.all(uv <= hi, axis=1))
-    if int(keep.sum()) < min_points:
-        return None
-    # the handle is what stands out furthest; surface bumps and noise sit just above min_standoff
-    keep &= standoff >= 0.5 * float(np.quantile(standoff[keep], 0.9))
-    if int(keep.sum()) < min_points:
-        return None
-    handle = object_points[keep]
-    centre = handle.mean(axis=0)
-    # along the bar, the middle of its visible extent: the points' density varies with the view
-    along = np.linalg.svd(handle - centre, full_matrices=False)[2][0]
-    t = np.quantile((handle - centre) @ along, [0.05, 0.95])
-    return centre + along * float(t.mean())
 
 
 def grasp_point_of_part(part_points: np.ndarray, joint_type: str, direction: np.ndarray,

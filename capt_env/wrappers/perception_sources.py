@@ -17,10 +17,10 @@ from capt_env.wrappers.estimate import (
     JointAxisEstimate,
     canonical_pivot,
     grasp_point_of_part,
-    handle_point,
     unit,
 )
 from capt_env.wrappers.estimate_fusion import EstimateFusion
+from capt_env.wrappers.moving_part_geometry import handle_point, opening_direction, part_plane
 
 
 class PerceptionSource(Protocol):
@@ -95,7 +95,9 @@ class CaptSource:
     The checkpoint is loaded on the first call. The target joint's channel is the env's target joint
     index; the grasp point is the handle standing off the plane of the points CAPT labels as that
     joint's moving part (``handle_point``), else the far edge of those points (all points if it
-    labels none). Successive estimates within an episode are fused (see ``estimate_fusion``);
+    labels none). The axis sign is set so that opening moves the part away from its body
+    (``opening_direction``): CAPT often gets a hinge's sign wrong while the line is right.
+    Successive estimates within an episode are fused (see ``estimate_fusion``);
     :meth:`reset` starts a new episode.
     """
 
@@ -136,6 +138,9 @@ class CaptSource:
         if grasp is None:
             grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
+        plane = part_plane(points, moving)
+        if plane is not None:
+            direction = opening_direction(joint.type, direction, pivot, grasp, plane.outward)
         return self._fusion.update(JointAxisEstimate(joint.type, direction, pivot, float(joint.state),
                                                      grasp, float(joint.confidence)))
 

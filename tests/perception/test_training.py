@@ -51,3 +51,18 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     assert all(r.joints and 0 <= r.joints[0].direction_error_deg <= 180 for r in ev.results)
     assert all(r.pa is not None for r in ev.results if r.method == "capt")
     assert "| box_revolute | capt |" in ev.table and "| box_revolute | pct_regression | - | - |" in ev.table
+
+
+def test_resuming_with_more_epochs_replans_the_cosine_schedule(tmp_path, data_dir):
+    import math
+
+    out = tmp_path / "run"
+    train(_cfg("capt", 2), data_dir, out)  # a finished 2-epoch plan ends at learning rate 0
+    longer = train(_cfg("capt", 4), data_dir, out)
+    rows = list(csv.DictReader(open(longer.log_path)))
+    assert [r["epoch"] for r in rows] == ["0", "1", "2", "3"]
+    base = _cfg("capt", 4).lr
+    # epochs 2 and 3 of the extended plan run at the 4-epoch cosine's values, not at 0
+    for epoch in (2, 3):
+        expected = base * (1 + math.cos(math.pi * epoch / 4)) / 2
+        assert float(rows[epoch]["lr"]) == pytest.approx(expected, rel=1e-5)  # the CSV keeps 6 digits

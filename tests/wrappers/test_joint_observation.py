@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part, handle_point
+from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part
 from capt_env.wrappers.joint_observation import (
     OBSERVATION_SIZE,
     build_dict,
@@ -14,6 +14,7 @@ from capt_env.wrappers.joint_observation import (
     flatten,
     observation_layout,
 )
+from capt_env.wrappers.moving_part_geometry import handle_point, opening_direction, part_plane
 
 
 def _estimate() -> JointAxisEstimate:
@@ -100,3 +101,20 @@ def test_handle_point_survives_mislabelled_body_points_surface_noise_and_uneven_
     h = handle_point(cloud, part)
     assert h is not None
     np.testing.assert_allclose(h, [-0.03, 0.0, 0.35], atol=0.02)
+
+
+def test_opening_direction_turns_the_axis_so_the_part_moves_away_from_its_body() -> None:
+    rng = np.random.default_rng(3)
+    cloud, door = _oven_like_scene(rng, with_handle=True)
+    plane = part_plane(cloud, door)
+    assert plane is not None
+    np.testing.assert_allclose(plane.outward, [-1.0, 0.0, 0.0], atol=1e-6)  # the body lies at x > 0
+    # an oven-like door hinged along its bottom edge (the y axis through z = 0), handle at the top:
+    # +y turns the top towards +x (into the body), so the opening axis is -y
+    pivot, grasp = np.zeros(3), np.array([-0.03, 0.0, 0.35])
+    for given in ([0.0, 1.0, 0.0], [0.0, -1.0, 0.0]):
+        u = opening_direction("revolute", np.array(given), pivot, grasp, plane.outward)
+        np.testing.assert_allclose(u, [0.0, -1.0, 0.0])
+    # a drawer pulls out along the outward normal whichever sign was estimated
+    u = opening_direction("prismatic", np.array([1.0, 0.0, 0.0]), pivot, grasp, plane.outward)
+    np.testing.assert_allclose(u, [-1.0, 0.0, 0.0])

@@ -1,0 +1,116 @@
+"""Geometry of a flat moving part (door, drawer front, lid) seen in an object's points, world frame.
+
+Its plane (robust to a segmentation's mislabelled points), the handle standing off that plane, and
+the sign of a joint axis that opens the part (moves it away from its body).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from capt_env.wrappers.estimate import unit
+
+
+def dominant_plane_inliers(points: np.ndarray, tolerance: float = 0.01, trials: int = 64,
+                           seed: int = 0) -> np.ndarray:
+    """Mask (M,) of the ``points`` (M, 3) within ``tolerance`` m of the plane through most of them.
+
+    RANSAC over ``trials`` planes through three points drawn with a fixed ``seed`` (deterministic).
+    """
+    rng = np.random.default_rng(seed)
+    best = np.zeros(len(points), dtype=bool)
+    if len(points) < 3:
+        return best
+    for _ in range(trials):
+        a, b, c = points[rng.choice(len(points), 3, replace=False)]
+        n = np.cross(b - a, c - a)
+        norm = np.linalg.norm(n)
+        if norm < 1e-9:
+            continue
+        inliers = np.abs((points - a) @ (n / norm)) < tolerance
+        if inliers.sum() > best.sum():
+            best = inliers
+    return best
+
+
+@dataclass(frozen=True)
+class PartPlane:
+    """The plane of a flat moving part (a door, drawer front or lid), world frame, metres.
+
+    ``centre`` (3,) lies on it, ``in_plane`` (2, 3) are two orthonormal in-plane directions and
+    ``outward`` (3,) is its unit normal turned away from the rest of the object: a closed part lies
+    on the outside of its body, so opening it moves it along ``outward``.
+    """
+
+    centre: np.ndarray
+    in_plane: np.ndarray
+    outward: np.ndarray
+
+
+def part_plane(object_points: np.ndarray, part_points: np.ndarray) -> PartPlane | None:
+    """The plane through most of ``part_points`` (M, 3) (``dominant_plane_inliers``, refitted by PCA to
+    those inliers: a segmentation's mislabelled body points would tilt a plain fit), its normal turned
+    away from the centroid of ``object_points`` (N, 3). None when no plane holds half of the part's
+    points (the part is not flat) or there are fewer than 10 of them."""
+    if len(part_points) < 10 or len(object_points) < 1:
+        return None
+    near = dominant_plane_inliers(part_points)
+    if int(near.sum()) < max(10, len(part_points) // 2):
+        return None
+    centre = part_points[near].mean(axis=0)
+    vt = np.linalg.svd(part_points[near] - centre, full_matrices=False)[2]
+    normal = vt[2]
+    if float((object_points.mean(axis=0) - centre) @ normal) > 0.0:
+        normal = -normal
+    return PartPlane(centre, vt[:2], normal)
+
+
+def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standoff: float = 0.012,
+                 max_standoff: float = 0.08, margin: float = 0.1, min_points: int = 3) -> np.ndarray | None:
+    """Centre (3,) of a handle standing off a flat moving part, or None; world frame, metres.
+
+    The part's plane is ``part_plane(object_points, part_points)``. The handle is the
+    ``object_points`` (N, 3) (all of the object's points: a segmentation may miss thin handle points)
+    between ``min_standoff`` and ``max_standoff`` m outside that plane and within the part's
+    in-plane extent grown by ``margin`` m (a view may show only some of the part), keeping those
+    standing at least half as far out as the outermost ones (a bar, not the part's own surface
+    noise); the point returned is their centroid moved, along their main direction, to the middle
+    of their extent. None when the part is not flat or fewer than ``min_points`` qualify.
+    """
+    plane = part_plane(object_points, part_points)
+    if plane is None or len(object_points) < min_points:
+        return None
+    standoff = (object_points - plane.centre) @ plane.outward
+    in_plane = (part_points - plane.centre) @ plane.in_plane.T
+    lo, hi = in_plane.min(axis=0) - margin, in_plane.max(axis=0) + margin
+    uv = (object_points - plane.centre) @ plane.in_plane.T
+    keep = ((standoff > min_standoff) & (standoff < max_standoff)
+            & np.all(uv >= lo, axis=1) & np.all(uv <= hi, axis=1))
+    if int(keep.sum()) < min_points:
+        return None
+    # the handle is what stands out furthest; surface bumps and noise sit just above min_standoff
+    keep &= standoff >= 0.5 * float(np.quantile(standoff[keep], 0.9))
+    if int(keep.sum()) < min_points:
+        return None
+    handle = object_points[keep]
+    centre = handle.mean(axis=0)
+    # along the bar, the middle of its visible extent: the points' density varies with the view
+    along = np.linalg.svd(handle - centre, full_matrices=False)[2][0]
+    t = np.quantile((handle - centre) @ along, [0.05, 0.95])
+    return centre + along * float(t.mean())
+
+
+def opening_direction(joint_type: str, direction: np.ndarray, pivot: np.ndarray, grasp: np.ndarray,
+                      outward: np.ndarray) -> np.ndarray:
+    """``direction`` (3,) or its negation, whichever opens the part: increasing the state moves the
+    grasp point (3,) along the part's ``outward`` normal (3,). Revolute: the grasp point's velocity
+    ``direction x (grasp - pivot)``; prismatic: the direction itself. World frame.
+
+    The sign of a hinge's axis is a global property of the shape (which side the hinge is on), the
+    one thing a single-view estimate most often gets wrong while the line itself is right.
+    """
+    u = unit(direction)
+    motion = np.cross(u, np.asarray(grasp, dtype=np.float64) - pivot) if joint_type == "revolute" else u
+    return -u if float(motion @ outward) < 0.0 else u
