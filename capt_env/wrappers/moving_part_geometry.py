@@ -11,28 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from capt_env.wrappers.estimate import unit
-
-
-def dominant_plane_inliers(points: np.ndarray, tolerance: float = 0.01, trials: int = 64,
-                           seed: int = 0) -> np.ndarray:
-    """Mask (M,) of the ``points`` (M, 3) within ``tolerance`` m of the plane through most of them.
-
-    RANSAC over ``trials`` planes through three points drawn with a fixed ``seed`` (deterministic).
-    """
-    rng = np.random.default_rng(seed)
-    best = np.zeros(len(points), dtype=bool)
-    if len(points) < 3:
-        return best
-    for _ in range(trials):
-        a, b, c = points[rng.choice(len(points), 3, replace=False)]
-        n = np.cross(b - a, c - a)
-        norm = np.linalg.norm(n)
-        if norm < 1e-9:
-            continue
-        inliers = np.abs((points - a) @ (n / norm)) < tolerance
-        if inliers.sum() > best.sum():
-            best = inliers
-    return best
+from capt_env.wrappers.plane_fit import ransac_plane
 
 
 @dataclass(frozen=True)
@@ -50,13 +29,13 @@ class PartPlane:
 
 
 def part_plane(object_points: np.ndarray, part_points: np.ndarray) -> PartPlane | None:
-    """The plane through most of ``part_points`` (M, 3) (``dominant_plane_inliers``, refitted by PCA to
+    """The plane through most of ``part_points`` (M, 3) (seeded RANSAC, 1 cm band, refitted by PCA to
     those inliers: a segmentation's mislabelled body points would tilt a plain fit), its normal turned
     away from the centroid of ``object_points`` (N, 3). None when no plane holds half of the part's
     points (the part is not flat) or there are fewer than 10 of them."""
     if len(part_points) < 10 or len(object_points) < 1:
         return None
-    near = dominant_plane_inliers(part_points)
+    near, _ = ransac_plane(part_points, iterations=64, threshold=0.01, seed=0)
     if int(near.sum()) < max(10, len(part_points) // 2):
         return None
     centre = part_points[near].mean(axis=0)

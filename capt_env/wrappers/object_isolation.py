@@ -16,6 +16,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from capt_env.wrappers.config import IsolationConfig
+from capt_env.wrappers.plane_fit import ransac_plane
 from capt_env.wrappers.robot_filter import RobotPointFilter
 
 
@@ -38,27 +39,10 @@ def fit_plane_ransac(points: np.ndarray, iterations: int, threshold: float, seed
     Only planes within ``max_tilt`` rad of horizontal are considered (a table, not a cabinet wall).
     Returns None if no plane has at least 3 inliers.
     """
-    if len(points) < 3:
+    mask, normal = ransac_plane(points, iterations, threshold, seed, max_tilt=max_tilt)
+    if normal is None or mask.sum() < 3:
         return None
-    rng = np.random.default_rng(seed)
-    best, best_count = None, 2
-    cos_tilt = np.cos(max_tilt)
-    for _ in range(iterations):
-        a, b, c = points[rng.choice(len(points), 3, replace=False)]
-        normal = np.cross(b - a, c - a)
-        norm = np.linalg.norm(normal)
-        if norm < 1e-9:
-            continue
-        normal = normal / norm
-        if abs(normal[2]) < cos_tilt:
-            continue
-        count = int((np.abs((points - a) @ normal) < threshold).sum())
-        if count > best_count:
-            best, best_count = (normal, a), count
-    if best is None:
-        return None
-    normal, a = best
-    inliers = points[np.abs((points - a) @ normal) < threshold]
+    inliers = points[mask]
     centre = inliers.mean(axis=0)
     _, _, vt = np.linalg.svd(inliers - centre, full_matrices=False)
     normal = vt[-1] if abs(vt[-1] @ normal) > 0.9 else normal
