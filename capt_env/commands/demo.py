@@ -25,6 +25,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", default="outputs/demo", help="where PNGs and MP4s go")
     parser.add_argument("--no-policy", action="store_true", help="only estimate; do not open the object")
     parser.add_argument("--no-video", action="store_true", help="run the policy without recording MP4s")
+    parser.add_argument("--task", default=None,
+                        help="YAML of TaskConfig overrides for every category (cameras, placement, ...), "
+                             "e.g. configs/tasks/two_cameras.yaml; no category/object key")
 
 
 def axis_errors(est_joint, info: dict) -> dict[str, float | None]:
@@ -68,6 +71,7 @@ def run(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
     import capt_env
+    from capt_env.commands.rollout import task_overrides
     from perception.checkpoints import default_checkpoint, shipped_categories
     from perception.inference import ArticulationEstimator
 
@@ -75,12 +79,13 @@ def run(args: argparse.Namespace) -> int:
     if not categories:
         raise SystemExit("no shipped checkpoint found; pass --category and --checkpoint")
     out_dir = Path(args.out)
+    overrides = task_overrides(args.task)
     report = []
     for category in categories:
         ckpt = args.checkpoint or default_checkpoint(category)
         estimator = ArticulationEstimator.from_checkpoint(ckpt)
         env = gym.make(capt_env.env_id(category), obs_mode="pointcloud",
-                       task={"split": "test", "cameras": [{"width": 160, "height": 160}]})
+                       task={"split": "test", "cameras": [{"width": 160, "height": 160}], **overrides})
         try:
             for ep in range(args.episodes):
                 tag = f"{category}_episode{ep}"
@@ -89,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
                     from capt_env.commands.demo_policy import open_with_capt
 
                     row.update(open_with_capt(category, ckpt, args.seed + ep, out_dir, tag,
-                                              video=not args.no_video))
+                                              video=not args.no_video, task=overrides))
                 report.append(row)
                 pos = "-" if row["position_m"] is None else f"{100 * row['position_m']:.1f} cm"
                 opened = "" if "success" not in row else (

@@ -6,9 +6,11 @@ from pathlib import Path
 
 
 def open_with_capt(category: str, checkpoint: str | Path, seed: int, out_dir: Path, tag: str,
-                   video: bool = True, every_k_steps: int = 5, max_steps: int = 200) -> dict:
+                   video: bool = True, every_k_steps: int = 5, max_steps: int = 200,
+                   task: dict | None = None) -> dict:
     """Run one episode (same seed, so the same unseen instance as the estimate) and return the outcome:
-    success, final open fraction, steps, and the MP4 path when ``video``."""
+    success, final open fraction, steps, and the MP4 path when ``video``. ``task`` holds TaskConfig
+    overrides (e.g. the cameras)."""
     import imageio.v2 as imageio
     import numpy as np
 
@@ -16,7 +18,8 @@ def open_with_capt(category: str, checkpoint: str | Path, seed: int, out_dir: Pa
     from agents.scripted.rollout import make_env
 
     wrapper = {"source": "capt", "checkpoint": str(checkpoint), "every_k_steps": every_k_steps}
-    env = make_env(category, wrapper, obs_mode="pointcloud", render_mode="rgb_array" if video else None)
+    env = make_env(category, wrapper, task=task, obs_mode="pointcloud",
+                   render_mode="rgb_array" if video else None)
     policy = ScriptedOpener()
     frames = []
     try:

@@ -54,3 +54,16 @@ def test_rollout_task_overrides_load_and_reject_a_category(tmp_path: Path) -> No
     bad.write_text("category: oven\n")
     with pytest.raises(SystemExit, match="category"):
         task_overrides(str(bad))
+
+
+def test_demo_estimates_an_unseen_object_with_the_shipped_checkpoint(tmp_path: Path) -> None:
+    """The main job's estimation half: shipped checkpoint, two cameras, an accurate axis and a PNG."""
+    out = tmp_path / "demo.json"
+    task = Path(__file__).resolve().parents[2] / "configs" / "tasks" / "two_cameras.yaml"
+    assert main(["demo", "--category", "oven", "--episodes", "1", "--no-policy", "--task", str(task),
+                 "--out", str(tmp_path), "--json", str(out)]) == 0
+    (episode,) = json.loads(out.read_text())["episodes"]
+    assert episode["category"] == "oven" and Path(episode["png"]).is_file()
+    assert episode["points"] > 1000
+    # the shipped oven model's test-split median direction error is 5.6 deg (benchmarks/README.md)
+    assert episode["direction_deg"] < 20.0 and episode["position_m"] < 0.05
