@@ -65,7 +65,7 @@ def test_load_yaml_file(tmp_path: Path) -> None:
 def test_shipped_configs_load() -> None:
     import yaml
 
-    from capt_env.commands.rollout import task_overrides
+    from capt_env.commands.task_overrides import task_overrides
     from capt_env.dataset.config import GenerateConfig
     from capt_env.tasks.config import TaskConfig
 

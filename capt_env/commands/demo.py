@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from capt_env.commands.json_output import write_json
+from capt_env.commands.task_overrides import add_task_argument, task_overrides
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -25,9 +26,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", default="outputs/demo", help="where PNGs and MP4s go")
     parser.add_argument("--no-policy", action="store_true", help="only estimate; do not open the object")
     parser.add_argument("--no-video", action="store_true", help="run the policy without recording MP4s")
-    parser.add_argument("--task", default=None,
-                        help="YAML of TaskConfig overrides for every category (cameras, placement, ...), "
-                             "e.g. configs/tasks/two_cameras.yaml; no category/object key")
+    add_task_argument(parser)
 
 
 def axis_errors(est_joint, info: dict) -> dict[str, float | None]:
@@ -71,7 +70,6 @@ def run(args: argparse.Namespace) -> int:
     import gymnasium as gym
 
     import capt_env
-    from capt_env.commands.rollout import task_overrides
     from perception.checkpoints import default_checkpoint, shipped_categories
     from perception.inference import ArticulationEstimator
 

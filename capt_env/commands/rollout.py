@@ -6,6 +6,7 @@ import argparse
 from dataclasses import asdict
 
 from capt_env.commands.json_output import write_json
+from capt_env.commands.task_overrides import add_task_argument, task_overrides
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -19,9 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
     parser.add_argument("--every-k-steps", type=int, default=5, help="perception period in env steps")
     parser.add_argument("--max-steps", type=int, default=200)
-    parser.add_argument("--task", default=None,
-                        help="YAML of TaskConfig overrides for every category (cameras, placement, ...), "
-                             "e.g. configs/tasks/two_cameras.yaml; no category/object key")
+    add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
 
 
@@ -36,22 +35,6 @@ def _policy(args: argparse.Namespace):
     from agents.scripted.opener import ScriptedOpener
 
     return ScriptedOpener()
-
-
-def task_overrides(path: str | None) -> dict:
-    """TaskConfig keys from a YAML file, applied to every category (validated when the env is made)."""
-    if path is None:
-        return {}
-    import yaml
-
-    with open(path) as fh:
-        raw = yaml.safe_load(fh) or {}
-    if not isinstance(raw, dict):
-        raise SystemExit(f"--task {path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
-    clash = sorted({"category", "object"} & set(raw))
-    if clash:
-        raise SystemExit(f"--task {path}: {clash} would override --categories; remove them")
-    return raw
 
 
 def run(args: argparse.Namespace) -> int:

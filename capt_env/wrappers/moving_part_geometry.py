@@ -47,10 +47,12 @@ def part_plane(object_points: np.ndarray, part_points: np.ndarray) -> PartPlane 
 
 
 def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standoff: float = 0.012,
-                 max_standoff: float = 0.08, margin: float = 0.1, min_points: int = 3) -> np.ndarray | None:
+                 max_standoff: float = 0.08, margin: float = 0.1, min_points: int = 3,
+                 plane: PartPlane | None = None) -> np.ndarray | None:
     """Centre (3,) of a handle standing off a flat moving part, or None; world frame, metres.
 
-    The part's plane is ``part_plane(object_points, part_points)``. The handle is the
+    The part's plane is ``plane`` when the caller has it, else ``part_plane(object_points,
+    part_points)``. The handle is the
     ``object_points`` (N, 3) (all of the object's points: a segmentation may miss thin handle points)
     between ``min_standoff`` and ``max_standoff`` m outside that plane and within the part's
     in-plane extent grown by ``margin`` m (a view may show only some of the part), keeping those
@@ -58,7 +60,7 @@ def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standof
     noise); the point returned is their centroid moved, along their main direction, to the middle
     of their extent. None when the part is not flat or fewer than ``min_points`` qualify.
     """
-    plane = part_plane(object_points, part_points)
+    plane = plane or part_plane(object_points, part_points)
     if plane is None or len(object_points) < min_points:
         return None
     standoff = (object_points - plane.centre) @ plane.outward

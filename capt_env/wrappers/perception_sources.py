@@ -134,11 +134,11 @@ class CaptSource:
             if mask.sum() >= 3:
                 moving = points[mask]
         direction = unit(joint.direction)
-        grasp = handle_point(points, moving)
+        plane = part_plane(points, moving)
+        grasp = None if plane is None else handle_point(points, moving, plane=plane)
         if grasp is None:
             grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
-        plane = part_plane(points, moving)
         if plane is not None:
             direction = opening_direction(joint.type, direction, pivot, grasp, plane.outward)
         return self._fusion.update(JointAxisEstimate(joint.type, direction, pivot, float(joint.state),

@@ -41,7 +41,7 @@ def test_bench_writes_numbers(tmp_path: Path) -> None:
 
 
 def test_rollout_task_overrides_load_and_reject_a_category(tmp_path: Path) -> None:
-    from capt_env.commands.rollout import task_overrides
+    from capt_env.commands.task_overrides import task_overrides
     from capt_env.tasks.config import TaskConfig
     from perception.yaml_config import from_dict
 

@@ -1,0 +1,29 @@
+"""``--task PATH``: a YAML of TaskConfig overrides applied to every category of a command (cameras,
+placement, ...), shared by ``capt rollout`` and ``capt demo``."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_task_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--task PATH`` to a command's parser."""
+    parser.add_argument("--task", default=None,
+                        help="YAML of TaskConfig overrides for every category (cameras, placement, ...), "
+                             "e.g. configs/tasks/two_cameras.yaml; no category/object key")
+
+
+def task_overrides(path: str | None) -> dict:
+    """TaskConfig keys from a YAML file, applied to every category (validated when the env is made)."""
+    if path is None:
+        return {}
+    import yaml
+
+    with open(path) as fh:
+        raw = yaml.safe_load(fh) or {}
+    if not isinstance(raw, dict):
+        raise SystemExit(f"--task {path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
+    clash = sorted({"category", "object"} & set(raw))
+    if clash:
+        raise SystemExit(f"--task {path}: {clash} would override --categories; remove them")
+    return raw
