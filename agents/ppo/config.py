@@ -22,6 +22,8 @@ class PPOHyperparams:
     discount ``gamma`` (per 50 ms control step), GAE ``gae_lambda``, PPO ``clip_range``, entropy
     bonus ``ent_coef``, value loss weight ``vf_coef``, gradient norm clip ``max_grad_norm``.
     ``net_arch``: hidden layer widths of the policy and value MLPs (separate networks, tanh).
+    ``log_std_init``: initial log standard deviation of the Gaussian actions (0: std 1; a residual
+    policy starts closer to its base with e.g. -1).
     """
 
     n_steps: int = 1024
@@ -35,6 +37,7 @@ class PPOHyperparams:
     vf_coef: float = 0.5
     max_grad_norm: float = 0.5
     net_arch: tuple[int, ...] = (256, 256)
+    log_std_init: float = 0.0
 
     def validate(self) -> None:
         require(self.n_steps >= 2, f"ppo.n_steps must be >= 2, got {self.n_steps}")
@@ -49,6 +52,21 @@ class PPOHyperparams:
         require(self.max_grad_norm > 0, f"ppo.max_grad_norm must be > 0, got {self.max_grad_norm}")
         require(len(self.net_arch) >= 1 and all(w >= 1 for w in self.net_arch),
                 f"ppo.net_arch must list >= 1 positive layer widths, got {list(self.net_arch)}")
+        require(-5.0 <= self.log_std_init <= 1.0,
+                f"ppo.log_std_init must be in [-5, 1], got {self.log_std_init}")
+
+
+@dataclass(frozen=True)
+class ResidualConfig:
+    """Residual PPO on the scripted opener (agents.ppo.residual): when ``enabled``, the executed
+    action is the opener's plus ``scale`` times the policy's (clipped to [-1, 1]), and the policy
+    sees the opener's action and phase as well."""
+
+    enabled: bool = False
+    scale: float = 0.2
+
+    def validate(self) -> None:
+        require(0.0 < self.scale <= 2.0, f"residual.scale must be in (0, 2], got {self.scale}")
 
 
 def _default_perception() -> PerceptionWrapperConfig:
@@ -71,7 +89,10 @@ class PPOTrainConfig:
     rollout that reaches it), ``ppo`` hyperparameters, global ``seed``, torch ``device``
     (``cpu`` is fastest for small MLPs), a checkpoint every ``checkpoint_every_steps`` env steps,
     and ``normalize_obs``: running mean/std observation normalisation (``VecNormalize``, saved as
-    ``vecnormalize.pkl`` next to the model).
+    ``vecnormalize.pkl`` next to the model). ``residual``: learn corrections to the scripted
+    opener instead of actions from scratch (:class:`ResidualConfig`). ``continue_after_success``:
+    training episodes do not end at the task's success but run to ``max_episode_steps``
+    (:class:`agents.ppo.train.ContinueAfterSuccess` says why).
     """
 
     category: str = "laptop"
@@ -86,6 +107,8 @@ class PPOTrainConfig:
     max_episode_steps: int = MAX_EPISODE_STEPS
     task: dict[str, Any] = field(default_factory=dict)
     normalize_obs: bool = True
+    residual: ResidualConfig = field(default_factory=ResidualConfig)
+    continue_after_success: bool = True
 
     def validate(self) -> None:
         require(self.category in CATEGORY_ENV_NAMES,
@@ -98,6 +121,7 @@ class PPOTrainConfig:
         require(self.n_envs >= 1, f"n_envs must be >= 1, got {self.n_envs}")
         require(self.total_timesteps >= 1, f"total_timesteps must be >= 1, got {self.total_timesteps}")
         self.ppo.validate()
+        self.residual.validate()
         rollout = self.ppo.n_steps * self.n_envs
         require(self.ppo.batch_size <= rollout,
                 f"ppo.batch_size ({self.ppo.batch_size}) must be <= ppo.n_steps * n_envs ({rollout})")

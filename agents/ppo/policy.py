@@ -1,4 +1,8 @@
-"""A trained PPO model as a policy with the scripted opener's interface (``reset``, ``act``)."""
+"""A trained PPO model as a policy with the scripted opener's interface (``reset``, ``act``).
+
+A residual model (``residual.enabled`` in its run's ``config.yaml``) is run with the scripted
+opener beside it, exactly as in training (agents.ppo.residual).
+"""
 
 from __future__ import annotations
 
@@ -7,10 +11,23 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 from stable_baselines3 import PPO
 from stable_baselines3.common.vec_env import VecNormalize
 
-from agents.ppo.train import vecnormalize_path
+from agents.ppo.residual import RESIDUAL_OBSERVATION_SIZE, ResidualComposer
+from agents.ppo.train import CONFIG_FILE, vecnormalize_path
+
+
+def run_config_of(model_path: str | Path) -> dict[str, Any] | None:
+    """The ``config.yaml`` of the run a model belongs to (beside ``final.zip``, or one level up from
+    ``checkpoints/ppo_<N>_steps.zip``), as a dict; None when there is none."""
+    model_path = Path(model_path)
+    for folder in (model_path.parent, model_path.parent.parent):
+        if (folder / CONFIG_FILE).is_file():
+            loaded = yaml.safe_load((folder / CONFIG_FILE).read_text())
+            return loaded if isinstance(loaded, dict) else None
+    return None
 
 
 class PPOPolicy:
@@ -19,11 +36,18 @@ class PPOPolicy:
     :param model: the PPO model.
     :param obs_norm: its ``VecNormalize`` statistics (observations are normalised with them, in
         evaluation mode: the statistics stay fixed), or None when trained without normalisation.
+    :param residual: for a residual model, the composer that runs the scripted opener beside it.
     """
 
-    def __init__(self, model: PPO, obs_norm: VecNormalize | None = None) -> None:
+    def __init__(self, model: PPO, obs_norm: VecNormalize | None = None,
+                 residual: ResidualComposer | None = None) -> None:
+        expected = (RESIDUAL_OBSERVATION_SIZE,) if residual is not None else None
+        if expected is not None and model.observation_space.shape != expected:
+            raise ValueError(f"a residual PPO model takes observations of shape {expected}, this one "
+                             f"{model.observation_space.shape}")
         self.model = model
         self.obs_norm = obs_norm
+        self.residual = residual
         if obs_norm is not None:
             obs_norm.training = False
 
@@ -32,7 +56,8 @@ class PPOPolicy:
              device: str = "cpu") -> PPOPolicy:
         """Load ``path`` (``final.zip`` or a ``ppo_<N>_steps.zip`` checkpoint) and, when it exists, the
         normalisation saved beside it (``vecnormalize.pkl`` / ``ppo_vecnormalize_<N>_steps.pkl``) or
-        given as ``vecnormalize``. Both files are unpickled: load only files you trust."""
+        given as ``vecnormalize``. Both files are unpickled: load only files you trust. The run's
+        ``config.yaml`` (see :func:`run_config_of`) says whether the model is residual."""
         path = Path(path)
         if not path.is_file():
             raise FileNotFoundError(f"no PPO model at {path}")
@@ -46,10 +71,21 @@ class PPOPolicy:
                                  "not VecNormalize statistics")
         elif vecnormalize is not None:
             raise FileNotFoundError(f"no VecNormalize statistics at {norm_path}")
-        return cls(PPO.load(path, device=device), obs_norm)
+        model = PPO.load(path, device=device)
+        residual = None
+        run_config = run_config_of(path) or {}
+        residual_cfg = run_config.get("residual") or {}
+        if residual_cfg.get("enabled", False):
+            residual = ResidualComposer(float(residual_cfg.get("scale", 0.2)))
+        elif model.observation_space.shape == (RESIDUAL_OBSERVATION_SIZE,):
+            raise ValueError(f"{path} is a residual PPO model but no run config.yaml with "
+                             "'residual: {enabled: true, scale: ...}' lies beside it")
+        return cls(model, obs_norm, residual)
 
     def reset(self) -> None:
-        """Start a new episode (the MLP policy keeps no state)."""
+        """Start a new episode (the MLP keeps no state; a residual model's scripted opener restarts)."""
+        if self.residual is not None:
+            self.residual.reset()
 
     def act(self, obs: np.ndarray, info: dict[str, Any] | None = None) -> np.ndarray:
         """Action (7,) float32 in [-1, 1] for ``pd_ee_delta_pose`` from a flat (38,) observation.
@@ -58,7 +94,10 @@ class PPOPolicy:
         unused (same signature as :meth:`agents.scripted.ScriptedOpener.act`).
         """
         x = np.asarray(obs, dtype=np.float32)
+        if self.residual is not None:
+            x = self.residual.observe(x, info)
         if self.obs_norm is not None:
             x = self.obs_norm.normalize_obs(x).astype(np.float32)
         action, _ = self.model.predict(x, deterministic=True)
-        return np.asarray(action, dtype=np.float32)
+        action = np.asarray(action, dtype=np.float32)
+        return self.residual.compose(action) if self.residual is not None else action

@@ -34,7 +34,7 @@ import gymnasium as gym
 import numpy as np
 import yaml
 from stable_baselines3 import PPO
-from stable_baselines3.common.callbacks import CheckpointCallback
+from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
 from stable_baselines3.common.logger import configure
 from stable_baselines3.common.monitor import Monitor
 from stable_baselines3.common.utils import set_random_seed
@@ -52,6 +52,36 @@ RESUMABLE_CHANGES = frozenset({"total_timesteps", "device", "checkpoint_every_st
 _CHECKPOINT_RE = re.compile(rf"^{CHECKPOINT_PREFIX}_(\d+)_steps\.zip$")
 
 
+class ContinueAfterSuccess(gym.Wrapper):
+    """Training episodes that run to their step limit instead of ending at the task's success.
+
+    ManiSkill ends an episode (``terminated``) the first step the part is open and at rest. With a
+    per-step dense reward that ending is a loss for the agent: holding the part open but moving
+    earns ~3 per step for the rest of the episode, succeeding earns 5 once. Without the
+    termination the best return is to open the part soon and leave it open and at rest (5 per
+    step), and ``success`` at the last step (what ``Monitor`` records) means it stayed open.
+    """
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict]:
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        if terminated and bool(info.get("success", False)):
+            terminated = False
+        return obs, reward, terminated, truncated, info
+
+
+class SuccessRateLogger(BaseCallback):
+    """Logs ``rollout/success_rate``: the task's success at the last step of SB3's window of recent
+    episodes (the ``success`` that ``Monitor`` records)."""
+
+    def _on_step(self) -> bool:
+        return True
+
+    def _on_rollout_end(self) -> None:
+        rate = episode_stats(self.model)["success_rate"]
+        if rate is not None:
+            self.logger.record("rollout/success_rate", rate)
+
+
 def make_train_env(config: PPOTrainConfig, rank: int) -> gym.Env:
     """Env number ``rank`` of a training run: train split, wrapped, with ``Monitor`` (records
     episode return, length and the task's ``success`` at the episode's last step)."""
@@ -59,8 +89,14 @@ def make_train_env(config: PPOTrainConfig, rank: int) -> gym.Env:
     from agents.scripted.rollout import make_env
 
     perception = replace(config.perception, seed=config.perception.seed + rank)
-    env = make_env(config.category, perception, task=config.train_task(), obs_mode=config.obs_mode,
-                   max_episode_steps=config.max_episode_steps)
+    env: gym.Env = make_env(config.category, perception, task=config.train_task(),
+                            obs_mode=config.obs_mode, max_episode_steps=config.max_episode_steps)
+    if config.residual.enabled:
+        from agents.ppo.residual import ScriptedResidualWrapper
+
+        env = ScriptedResidualWrapper(env, config.residual.scale)
+    if config.continue_after_success:
+        env = ContinueAfterSuccess(env)
     return Monitor(env, info_keywords=("success",))
 
 
@@ -174,7 +210,8 @@ def train_ppo(config: PPOTrainConfig, out_dir: str | Path, resume: bool = True,
                         n_epochs=hp.n_epochs, learning_rate=hp.learning_rate, gamma=hp.gamma,
                         gae_lambda=hp.gae_lambda, clip_range=hp.clip_range, ent_coef=hp.ent_coef,
                         vf_coef=hp.vf_coef, max_grad_norm=hp.max_grad_norm,
-                        policy_kwargs={"net_arch": {"pi": list(hp.net_arch), "vf": list(hp.net_arch)}},
+                        policy_kwargs={"net_arch": {"pi": list(hp.net_arch), "vf": list(hp.net_arch)},
+                                       "log_std_init": hp.log_std_init},
                         seed=config.seed, device=config.device, verbose=0)
         start = int(model.num_timesteps)
         log_dir = out_dir / "logs" / f"from_{start}"
@@ -188,7 +225,7 @@ def train_ppo(config: PPOTrainConfig, out_dir: str | Path, resume: bool = True,
                 save_freq=max(1, config.checkpoint_every_steps // config.n_envs),
                 save_path=str(ckpt_dir), name_prefix=CHECKPOINT_PREFIX,
                 save_vecnormalize=config.normalize_obs)
-            model.learn(total_timesteps=remaining, callback=checkpoints,
+            model.learn(total_timesteps=remaining, callback=CallbackList([checkpoints, SuccessRateLogger()]),
                         reset_num_timesteps=found is None, progress_bar=False)
         wall = time.perf_counter() - t0
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+import gymnasium as gym
 import numpy as np
 import pytest
 import torch
@@ -12,7 +13,7 @@ import torch
 import capt_env  # noqa: F401
 from agents.ppo.config import PPOTrainConfig
 from agents.ppo.policy import PPOPolicy
-from agents.ppo.train import latest_checkpoint, train_ppo
+from agents.ppo.train import ContinueAfterSuccess, latest_checkpoint, train_ppo
 from agents.scripted.rollout import make_env
 from perception.yaml_config import ConfigError, from_dict, load_yaml
 
@@ -27,10 +28,13 @@ def tiny(**changes: object) -> PPOTrainConfig:
 
 
 def test_shipped_configs_load() -> None:
-    for name in ("laptop", "drawer_cabinet"):
-        cfg = load_yaml(PPOTrainConfig, ROOT / "configs" / "ppo" / f"{name}.yaml")
-        assert cfg.category == name
+    paths = sorted((ROOT / "configs" / "ppo").glob("*.yaml"))
+    assert {p.stem for p in paths} >= {"laptop", "drawer_cabinet", "drawer_cabinet_residual"}
+    for path in paths:
+        cfg = load_yaml(PPOTrainConfig, path)
+        assert path.stem.startswith(cfg.category)
         assert cfg.perception.source == "noisy_oracle"
+        assert cfg.residual.enabled == path.stem.endswith("_residual")
 
 
 @pytest.mark.parametrize(("changes", "match"), [
@@ -45,6 +49,9 @@ def test_shipped_configs_load() -> None:
     ({"task": {"yaw_nois": 0.1}}, "yaw_nois"),
     ({"perception": {"source": "capt", "checkpoint": "x.pt"}}, "pointcloud"),
     ({"device": "tpu"}, "device"),
+    ({"residual": {"enabled": True, "scale": 0.0}}, "residual.scale"),
+    ({"residual": {"enable": True}}, "enable"),
+    ({"ppo": {"log_std_init": 3.0}}, "log_std_init"),
 ])
 def test_bad_config_values_are_rejected(changes: dict, match: str) -> None:
     with pytest.raises(ConfigError, match=match):
@@ -77,7 +84,9 @@ def test_train_save_reload_resume(tmp_path: Path) -> None:
     assert latest_checkpoint(run)[1] == 64
     assert (run / "checkpoints" / "ppo_32_steps.zip").is_file()
     assert (run / "checkpoints" / "ppo_vecnormalize_32_steps.pkl").is_file()
-    assert len(_progress_rows(first["log_dir"])) == 2  # one row per rollout
+    rows = _progress_rows(first["log_dir"])
+    assert len(rows) == 2  # one row per rollout
+    assert 0.0 <= float(rows[-1]["rollout/success_rate"]) <= 1.0
 
     # reload: the same deterministic action as the in-memory model, without an env
     policy = PPOPolicy.load(run / "final.zip")
@@ -104,3 +113,25 @@ def test_train_save_reload_resume(tmp_path: Path) -> None:
     # seeded: a fresh run with the same config reproduces the first 64 steps exactly
     train_ppo(tiny(), tmp_path / "again", on_trained=keep_action)
     assert torch.equal(in_memory["params"], params_64)
+
+
+class _EndsEpisode(gym.Env):
+    """Terminates every step, with or without success."""
+
+    observation_space = gym.spaces.Box(-1, 1, (1,))
+    action_space = gym.spaces.Box(-1, 1, (1,))
+
+    def __init__(self, success: bool) -> None:
+        self.success = success
+
+    def reset(self, *, seed=None, options=None):  # noqa: ANN001, ANN201
+        return np.zeros(1, np.float32), {}
+
+    def step(self, action):  # noqa: ANN001, ANN201
+        return np.zeros(1, np.float32), 1.0, True, False, {"success": self.success}
+
+
+def test_training_episodes_continue_after_success_only() -> None:
+    assert ContinueAfterSuccess(_EndsEpisode(success=True)).step(np.zeros(1))[2] is False
+    assert ContinueAfterSuccess(_EndsEpisode(success=False)).step(np.zeros(1))[2] is True
+    assert tiny().continue_after_success and not tiny(continue_after_success=False).continue_after_success
