@@ -73,7 +73,10 @@ class PerceptionWrapperConfig:
     ``capt`` (a CAPT ``checkpoint``, loaded lazily on first use). Perception runs on reset and then
     every ``every_k_steps`` steps; in between the last estimate is repeated. ``isolation`` selects the
     object points fed to CAPT, downsampled to ``num_points``. ``obs_format``: ``flat`` (Box) or
-    ``dict``. ``seed`` seeds noise and downsampling.
+    ``dict``. ``seed`` seeds noise and downsampling. ``hinge_on_part_edge`` (``capt`` only): put a
+    revolute estimate's line on the edge of the flat moving part away from the grasp point, in the
+    part's plane, when CAPT's own line is more than 6 cm off that edge, and turn the direction into
+    the part's plane (``moving_part_geometry.hinge_on_edge``); off, the line is CAPT's own.
     """
 
     source: Source = "oracle"
@@ -84,6 +87,7 @@ class PerceptionWrapperConfig:
     noise: NoiseConfig = field(default_factory=NoiseConfig)
     obs_format: ObsFormat = "flat"
     seed: int = 0
+    hinge_on_part_edge: bool = True
 
     def validate(self) -> None:
         require(self.every_k_steps >= 1, f"every_k_steps must be >= 1, got {self.every_k_steps}")

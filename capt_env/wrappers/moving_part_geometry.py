@@ -95,3 +95,40 @@ def opening_direction(joint_type: str, direction: np.ndarray, pivot: np.ndarray,
     u = unit(direction)
     motion = np.cross(u, np.asarray(grasp, dtype=np.float64) - pivot) if joint_type == "revolute" else u
     return -u if float(motion @ outward) < 0.0 else u
+
+
+def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, part_points: np.ndarray,
+                  pivot: np.ndarray | None = None, tolerance: float = 0.06,
+                  edge_quantile: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
+    """A flat part's hinge line checked against its points: (unit direction (3,), pivot (3,)), world
+    frame, metres.
+
+    A closed door, lid or oven door turns about a line in (or just behind) its own plane along its
+    edge farthest from the handle. The estimated ``direction`` is projected into the part's plane
+    (its in-plane component is kept, so the estimate still decides which edge). The estimated
+    ``pivot`` is kept when it lies within ``tolerance`` of that edge of ``part_points`` (M, 3) (the
+    edge at the ``edge_quantile`` of the points' coordinates across the axis, on the side away from
+    ``grasp`` (3,)) and of the plane; otherwise (or when ``pivot`` is None) the line is put on that
+    edge, in the plane. The returned pivot is the line's point closest to ``grasp``, the sign of the
+    direction is kept. A direction more than 60 deg out of the plane is not a hinge of this part:
+    it is returned unchanged, with ``pivot`` (or the plane's centre) moved along it.
+    """
+    g = np.asarray(grasp, dtype=np.float64)
+    u = unit(direction)
+    along = u - float(u @ plane.outward) * plane.outward
+    if np.linalg.norm(along) < np.sin(np.radians(30.0)):
+        base = plane.centre if pivot is None else np.asarray(pivot, dtype=np.float64)
+        return u, base + u * float((g - base) @ u)
+    along = unit(along)
+    across = unit(np.cross(plane.outward, along))
+    s = (part_points - plane.centre) @ across
+    s_grasp = float((g - plane.centre) @ across)
+    lo, hi = np.quantile(s, [edge_quantile, 1.0 - edge_quantile])
+    edge = float(lo if abs(s_grasp - lo) > abs(s_grasp - hi) else hi)
+    line_point = plane.centre + across * edge
+    if pivot is not None:
+        p = np.asarray(pivot, dtype=np.float64)
+        if (abs(float((p - plane.centre) @ across) - edge) <= tolerance
+                and abs(float((p - plane.centre) @ plane.outward)) <= tolerance):
+            line_point = p
+    return along, line_point + along * float((g - line_point) @ along)

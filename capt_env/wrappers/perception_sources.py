@@ -20,7 +20,7 @@ from capt_env.wrappers.estimate import (
     unit,
 )
 from capt_env.wrappers.estimate_fusion import EstimateFusion
-from capt_env.wrappers.moving_part_geometry import handle_point, opening_direction, part_plane
+from capt_env.wrappers.moving_part_geometry import handle_point, hinge_on_edge, opening_direction, part_plane
 
 
 class PerceptionSource(Protocol):
@@ -103,9 +103,10 @@ class CaptSource:
 
     needs_points = True
 
-    def __init__(self, checkpoint: str, seed: int = 0) -> None:
+    def __init__(self, checkpoint: str, seed: int = 0, hinge_on_part_edge: bool = False) -> None:
         self.checkpoint = checkpoint
         self.seed = seed
+        self.hinge_on_part_edge = hinge_on_part_edge
         self._estimator: Any = None
         self._fusion = EstimateFusion()
 
@@ -139,13 +140,16 @@ class CaptSource:
         if grasp is None:
             grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
+        if plane is not None and self.hinge_on_part_edge and joint.type == "revolute":
+            direction, pivot = hinge_on_edge(direction, grasp, plane, moving, pivot=pivot)
         if plane is not None:
             direction = opening_direction(joint.type, direction, pivot, grasp, plane.outward)
         return self._fusion.update(JointAxisEstimate(joint.type, direction, pivot, float(joint.state),
                                                      grasp, float(joint.confidence)))
 
 
-def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: int) -> PerceptionSource:
+def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: int,
+                hinge_on_part_edge: bool = False) -> PerceptionSource:
     """The source named ``source`` ("oracle", "noisy_oracle", "capt")."""
     if source == "oracle":
         return OracleSource()
@@ -154,5 +158,5 @@ def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: i
     if source == "capt":
         if checkpoint is None:
             raise ValueError("source 'capt' needs a checkpoint path")
-        return CaptSource(checkpoint, seed)
+        return CaptSource(checkpoint, seed, hinge_on_part_edge)
     raise ValueError(f"unknown perception source {source!r}")

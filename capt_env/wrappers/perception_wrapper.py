@@ -49,7 +49,8 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         cfg = from_dict(PerceptionWrapperConfig, config or {}, where="perception_wrapper")
         cfg.validate()
         self.config = cfg
-        self.source: PerceptionSource = make_source(cfg.source, cfg.noise, cfg.checkpoint, cfg.seed)
+        self.source: PerceptionSource = make_source(cfg.source, cfg.noise, cfg.checkpoint, cfg.seed,
+                                                     cfg.hinge_on_part_edge)
         obs_mode = getattr(env.unwrapped, "obs_mode", None)
         if self.source.needs_points and obs_mode != "pointcloud":
             raise ValueError(

@@ -14,7 +14,7 @@ from capt_env.wrappers.joint_observation import (
     flatten,
     observation_layout,
 )
-from capt_env.wrappers.moving_part_geometry import handle_point, opening_direction, part_plane
+from capt_env.wrappers.moving_part_geometry import handle_point, hinge_on_edge, opening_direction, part_plane
 
 
 def _estimate() -> JointAxisEstimate:
@@ -118,3 +118,38 @@ def test_opening_direction_turns_the_axis_so_the_part_moves_away_from_its_body()
     # a drawer pulls out along the outward normal whichever sign was estimated
     u = opening_direction("prismatic", np.array([1.0, 0.0, 0.0]), pivot, grasp, plane.outward)
     np.testing.assert_allclose(u, [-1.0, 0.0, 0.0])
+
+
+def test_hinge_on_edge_moves_a_far_off_line_onto_the_door_edge_away_from_the_handle() -> None:
+    rng = np.random.default_rng(4)
+    cloud, door = _oven_like_scene(rng, with_handle=True)
+    plane = part_plane(cloud, door)
+    assert plane is not None
+    grasp = np.array([-0.03, 0.0, 0.35])  # handle at the top: the hinge is the bottom edge z = 0
+    # CAPT's line: 12 deg out of the door's plane, 15 deg off in it, and 20 cm away from the edge
+    tilt = np.array([np.sin(np.radians(12)), np.cos(np.radians(15)), np.sin(np.radians(15))])
+    given = tilt / np.linalg.norm(tilt)
+    u, pivot = hinge_on_edge(given, grasp, plane, door)
+    assert abs(u @ plane.outward) < 1e-9  # in the door's plane
+    assert u @ given > 0  # the sign is kept
+    np.testing.assert_allclose(np.degrees(np.arccos(u @ [0.0, 1.0, 0.0])), 15.0, atol=0.5)
+    # the line passes through the bottom edge where it crosses the door's middle (y ~ 0, z ~ 0)
+    t = (np.array([0.0, 0.0, 0.0]) - pivot) @ u
+    assert np.linalg.norm(pivot + t * u - [0.0, 0.0, 0.0]) < 0.02
+    # a door hinged on its side (handle near y = +0.18): the line moves to the edge y = -0.2
+    side_grasp = np.array([-0.03, 0.18, 0.2])
+    u, pivot = hinge_on_edge(np.array([0.0, 0.0, -1.0]), side_grasp, plane, door)
+    np.testing.assert_allclose(u, [0.0, 0.0, -1.0], atol=1e-9)
+    np.testing.assert_allclose(pivot[:2], [0.0, -0.2], atol=0.02)
+    np.testing.assert_allclose(pivot[2], side_grasp[2], atol=1e-9)  # the point closest to the grasp
+    # an estimated pivot near that edge is kept (the hinge may sit behind the face or past the
+    # visible edge), one 20 cm off is replaced by the edge
+    near = np.array([0.03, -0.23, 0.1])
+    u, pivot = hinge_on_edge(np.array([0.0, 0.0, -1.0]), side_grasp, plane, door, pivot=near)
+    np.testing.assert_allclose(pivot, [0.03, -0.23, side_grasp[2]], atol=1e-9)
+    u, pivot = hinge_on_edge(np.array([0.0, 0.0, -1.0]), side_grasp, plane, door,
+                             pivot=np.array([0.1, -0.02, 0.1]))
+    np.testing.assert_allclose(pivot[:2], [0.0, -0.2], atol=0.02)
+    # an axis along the door's normal is no hinge of this door: the direction is left alone
+    u, _ = hinge_on_edge(np.array([1.0, 0.0, 0.0]), grasp, plane, door)
+    np.testing.assert_allclose(u, [1.0, 0.0, 0.0])
