@@ -12,7 +12,8 @@ from capt_env.commands.task_overrides import add_task_argument, task_overrides
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--categories", nargs="+", default=["cabinet_door"], help="object categories")
     parser.add_argument("--policy", default="scripted", choices=["scripted", "ppo"])
-    parser.add_argument("--model", default=None, help="PPO model .zip (with --policy ppo)")
+    parser.add_argument("--model", default=None,
+                        help="PPO model .zip (with --policy ppo; default: the category's shipped policy)")
     parser.add_argument("--perception", nargs="+", default=["oracle"],
                         choices=["oracle", "noisy_oracle", "capt"], help="perception sources to compare")
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
@@ -24,17 +25,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
 
 
-def _policy(args: argparse.Namespace):
-    """The policy to evaluate: the scripted opener, or a trained PPO model."""
+def _policy(args: argparse.Namespace, category: str) -> tuple[object, str | None]:
+    """The policy to evaluate and its model file: the scripted opener (None), or a trained PPO model
+    (``--model``, else the category's shipped one)."""
     if args.policy == "ppo":
-        if not args.model:
-            raise SystemExit("--policy ppo needs --model PATH (a final.zip of `capt train-ppo`)")
+        from agents.ppo.policies import shipped_policy
         from agents.ppo.policy import PPOPolicy
 
-        return PPOPolicy.load(args.model)
+        try:
+            model = args.model or shipped_policy(category)
+        except FileNotFoundError as err:
+            raise SystemExit(str(err)) from err
+        return PPOPolicy.load(model), str(model)
     from agents.scripted.opener import ScriptedOpener
 
-    return ScriptedOpener()
+    return ScriptedOpener(), None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -58,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
                 obs_mode = "pointcloud"
             env = make_env(category, wrapper, task=task, obs_mode=obs_mode)
-            policy = _policy(args)
+            policy, model = _policy(args, category)
             try:
                 episodes = [run_episode(env, policy, s, args.max_steps)
                             for s in tqdm(seeds, desc=f"{category} {source}")]
@@ -66,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
                 env.close()
             wins = sum(e.success for e in episodes)
             lo, hi = wilson_interval(wins, len(episodes))
-            row = {"category": category, "policy": args.policy, "perception": source,
+            row = {"category": category, "policy": args.policy, "model": model, "perception": source,
                    "success_rate": wins / len(episodes), "ci95": [lo, hi],
                    "mean_open_fraction": float(np.mean([e.open_fraction for e in episodes])),
                    "mean_steps": float(np.mean([e.steps for e in episodes])),

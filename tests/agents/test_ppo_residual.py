@@ -99,7 +99,8 @@ def test_wrapper_passes_the_env_checker() -> None:
         env.close()
 
 
-def test_saved_residual_model_runs_with_the_opener(tmp_path: Path, first_obs: tuple[np.ndarray, dict]) -> None:
+def test_saved_residual_model_runs_with_the_opener(tmp_path: Path,
+                                                   first_obs: tuple[np.ndarray, dict]) -> None:
     config = from_dict(PPOTrainConfig, {
         "category": "drawer_cabinet", "perception": {"source": "noisy_oracle", "every_k_steps": 2},
         "n_envs": 1, "total_timesteps": 32, "seed": 1, "max_episode_steps": 16,

@@ -75,7 +75,8 @@ def test_estimate_errors_on_constructed_estimates() -> None:
     from capt_env.commands.estimate_errors import estimate_errors
     from capt_env.wrappers.estimate import JointAxisEstimate
 
-    truth = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), 0.0, np.array([0.3, 0.0, 0.2]))
+    truth = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), 0.0,
+                              np.array([0.3, 0.0, 0.2]))
     flipped = JointAxisEstimate("revolute", np.array([0.0, 0.0, -1.0]), np.array([0.0, 0.03, 0.0]), 0.0,
                                 np.array([0.3, 0.04, 0.2]))
     e = estimate_errors(flipped, truth)
