@@ -29,7 +29,9 @@ class ScriptedOpenerConfig:
     ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost
     grip). The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than
     ``slip_distance`` m from the part's perceived grasp point for ``slip_steps`` steps (longer than
-    the perception period, so one bad estimate, e.g. of a handle the hand now hides, is not a slip).
+    the perception period, so one bad estimate, e.g. of a handle the hand now hides, is not a slip)
+    and its fingers are less than ``hold_gap`` m apart (closed on nothing; a gap means they hold
+    the handle, whatever the perceived grasp point says).
     After release it backs off ``retreat_distance`` m.
     """
 
@@ -56,6 +58,7 @@ class ScriptedOpenerConfig:
     stall_steps: int = 12
     slip_distance: float = 0.07
     slip_steps: int = 8
+    hold_gap: float = 0.004
     max_regrasps: int = 2
     retreat_distance: float = 0.08
     release_steps: int = 6
@@ -64,7 +67,7 @@ class ScriptedOpenerConfig:
         for key in ("pregrasp_offset", "max_step_m", "max_step_rad", "pos_tolerance", "rot_tolerance",
                     "revolute_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
                     "revolute_target", "prismatic_target",
-                    "slip_distance"):
+                    "slip_distance", "hold_gap"):
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",
                     "slip_steps"):

@@ -26,8 +26,9 @@ Strategy, per episode:
    re-estimation corrects the path.
 5. ``RELEASE`` when that state reaches the target (or stops growing: a limit), open, and
    ``RETREAT`` along the outward normal; then ``DONE`` (hold still, gripper open).
-If the TCP stays away from the part's grasp point for ``slip_steps`` while pulling, it goes back to
-1; if pulling stalls short of the target (a slipping grip, or the arm's range), it releases, retreats
+If the TCP stays away from the part's grasp point for ``slip_steps`` while pulling and the fingers
+have closed on nothing (their gap, from the Panda's qpos, below ``hold_gap``), it goes back to 1;
+if pulling stalls short of the target (a slipping grip, or the arm's range), it releases, retreats
 and goes back to 1 from the part's new pose (re-grasps are bounded by ``max_regrasps``).
 """
 
@@ -184,10 +185,18 @@ class ScriptedOpener:
     def act(self, obs: np.ndarray | dict[str, np.ndarray], info: dict[str, Any] | None = None) -> np.ndarray:
         """Action (7,) in [-1, 1] for ``pd_ee_delta_pose`` from a joint-axis observation."""
         proprio, est = decode_observation(obs)
-        return self.act_on(est, proprio["tcp_pose"])
+        qpos = np.asarray(proprio["qpos"], dtype=np.float64).reshape(-1)
+        return self.act_on(est, proprio["tcp_pose"], finger_gap=float(qpos[7] + qpos[8]))
 
-    def act_on(self, est: JointAxisEstimate, tcp_pose: np.ndarray) -> np.ndarray:
-        """Action (7,) from an estimate and the TCP pose (7,) (position m, quaternion wxyz), world frame."""
+    def act_on(self, est: JointAxisEstimate, tcp_pose: np.ndarray,
+               finger_gap: float | None = None) -> np.ndarray:
+        """Action (7,) from an estimate and the TCP pose (7,) (position m, quaternion wxyz), world frame.
+
+        ``finger_gap``: the distance between the Panda's fingers (m), when known. While pulling, a gap
+        of at least ``hold_gap`` means the fingers still hold something, so the hand is not slipped
+        whatever the perceived grasp point says (a part turned far from its first pose is often
+        segmented worse).
+        """
         cfg = self.cfg
         p = np.asarray(tcp_pose[:3], dtype=np.float64)
         r = quat_to_matrix(tcp_pose[3:7])
@@ -217,7 +226,7 @@ class ScriptedOpener:
             return action
 
         if self.phase == Phase.PULL:
-            return self._pull(est, p, r)
+            return self._pull(est, p, r, finger_gap)
 
         if self.phase == Phase.RELEASE:
             action = np.zeros(7, np.float32)
@@ -244,7 +253,8 @@ class ScriptedOpener:
         action[6] = GRIPPER_OPEN
         return action
 
-    def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray) -> np.ndarray:
+    def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
+              finger_gap: float | None = None) -> np.ndarray:
         cfg = self.cfg
         assert self._grasp_p is not None and self._grasp_r is not None
         revolute = est.joint_type == "revolute"
@@ -268,7 +278,8 @@ class ScriptedOpener:
             action = np.zeros(7, np.float32)
             action[6] = GRIPPER_CLOSE
             return action
-        far = np.linalg.norm(p - est.grasp_point) > cfg.slip_distance
+        holding = finger_gap is not None and finger_gap >= cfg.hold_gap
+        far = np.linalg.norm(p - est.grasp_point) > cfg.slip_distance and not holding
         self._slip_count = self._slip_count + 1 if far else 0
         if self._slip_count >= cfg.slip_steps and self.regrasps < cfg.max_regrasps:
             self.regrasps += 1

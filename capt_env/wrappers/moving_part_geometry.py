@@ -99,7 +99,7 @@ def opening_direction(joint_type: str, direction: np.ndarray, pivot: np.ndarray,
 
 def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, part_points: np.ndarray,
                   pivot: np.ndarray | None = None, tolerance: float = 0.06,
-                  edge_quantile: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
+                  edge_quantile: float = 0.02, min_aspect: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
     """A flat part's hinge line checked against its points: (unit direction (3,), pivot (3,)), world
     frame, metres.
 
@@ -110,13 +110,17 @@ def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, pa
     edge at the ``edge_quantile`` of the points' coordinates across the axis, on the side away from
     ``grasp`` (3,)) and of the plane; otherwise (or when ``pivot`` is None) the line is put on that
     edge, in the plane. The returned pivot is the line's point closest to ``grasp``, the sign of the
-    direction is kept. A direction more than 60 deg out of the plane is not a hinge of this part:
-    it is returned unchanged, with ``pivot`` (or the plane's centre) moved along it.
+    direction is kept. A direction more than 60 deg out of the plane is not a hinge of this part,
+    and a part whose points spread less than ``min_aspect`` as much across their main in-plane
+    direction as along it is a bar (an eyeglasses temple), not a flat panel: then the direction is returned
+    unchanged, with ``pivot`` (or the plane's centre) moved along it.
     """
     g = np.asarray(grasp, dtype=np.float64)
     u = unit(direction)
     along = u - float(u @ plane.outward) * plane.outward
-    if np.linalg.norm(along) < np.sin(np.radians(30.0)):
+    uv = (part_points - plane.centre) @ plane.in_plane.T
+    spread = np.linalg.svd(uv - uv.mean(axis=0), compute_uv=False)  # along its two main directions
+    if np.linalg.norm(along) < np.sin(np.radians(30.0)) or spread[1] < min_aspect * spread[0]:
         base = plane.centre if pivot is None else np.asarray(pivot, dtype=np.float64)
         return u, base + u * float((g - base) @ u)
     along = unit(along)

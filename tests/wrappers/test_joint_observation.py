@@ -153,3 +153,9 @@ def test_hinge_on_edge_moves_a_far_off_line_onto_the_door_edge_away_from_the_han
     # an axis along the door's normal is no hinge of this door: the direction is left alone
     u, _ = hinge_on_edge(np.array([1.0, 0.0, 0.0]), grasp, plane, door)
     np.testing.assert_allclose(u, [1.0, 0.0, 0.0])
+    # a bar (an eyeglasses temple, 40 x 1 cm) is not a panel: the line is left where it was
+    bar = np.stack([np.zeros(200), rng.uniform(-0.2, 0.2, 200), rng.uniform(0.0, 0.01, 200)], axis=1)
+    given_pivot = np.array([0.05, -0.1, 0.1])
+    u, pivot = hinge_on_edge(np.array([0.0, 0.0, 1.0]), grasp, plane, bar, pivot=given_pivot)
+    np.testing.assert_allclose(u, [0.0, 0.0, 1.0])
+    np.testing.assert_allclose(pivot, [0.05, -0.1, 0.35], atol=1e-9)
