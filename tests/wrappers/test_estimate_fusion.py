@@ -37,3 +37,15 @@ def test_reset_forgets() -> None:
     fusion.reset()
     fused = fusion.update(est([0, 0, -1], [0.0, 0.0, 0.0]))
     np.testing.assert_allclose(fused.direction, [0, 0, -1])
+
+
+def test_a_bad_first_look_is_outvoted() -> None:
+    """First estimate: the wrong sign, a pivot on the wrong edge and a grasp point on another part;
+    the next three agree with each other."""
+    fusion = EstimateFusion()
+    fusion.update(est([0, 0, -1], [0.2, 0.25, 0.0], grasp=(0.15, 0.16, 0.25)))
+    for y in (0.01, 0.0, -0.01):
+        fused = fusion.update(est([0, 0.02, 1], [0.15, -0.2 + y, 0.0], grasp=(0.04, -0.05 + y, 0.19)))
+    assert fused.direction[2] > 0.99  # three votes to one
+    np.testing.assert_allclose(fused.grasp_point, [0.04, -0.05, 0.19], atol=0.011)
+    np.testing.assert_allclose(fused.pivot[:2], [0.15, -0.2], atol=0.011)
