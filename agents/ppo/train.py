@@ -41,7 +41,7 @@ from stable_baselines3.common.utils import set_random_seed
 from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecNormalize
 
 from agents.ppo.config import PPOTrainConfig
-from perception.yaml_config import ConfigError, to_dict
+from perception.yaml_config import ConfigError, from_dict, to_dict
 
 CHECKPOINT_PREFIX = "ppo"
 FINAL_MODEL = "final.zip"
@@ -143,6 +143,10 @@ def episode_stats(model: PPO) -> dict[str, float | int | None]:
 
 
 def _check_resumable(saved: dict[str, Any], config: PPOTrainConfig, out_dir: Path) -> None:
+    """Raise ConfigError if ``config`` changes more of the saved run's config than a resume may.
+    The saved config is read with today's defaults (a field added since it was saved is not a
+    change); a key that no longer exists is an error that names it."""
+    saved = to_dict(from_dict(PPOTrainConfig, saved, where=str(out_dir / CONFIG_FILE)))
     current = to_dict(config)
     changed = sorted(k for k in set(saved) | set(current)
                      if k not in RESUMABLE_CHANGES and saved.get(k) != current.get(k))

@@ -25,15 +25,18 @@ def _fmt(value: float | None, spec: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from agents.ppo.config import PPOTrainConfig
     from agents.ppo.train import train_ppo
-    from perception.yaml_config import from_dict, load_yaml, to_dict
+    from perception.yaml_config import ConfigError, from_dict, load_yaml, to_dict
 
     cfg = to_dict(load_yaml(PPOTrainConfig, args.config))
     if args.total_timesteps is not None:
         cfg["total_timesteps"] = args.total_timesteps
     if args.device is not None:
         cfg["device"] = args.device
-    config = from_dict(PPOTrainConfig, cfg)
-    summary = train_ppo(config, args.out, resume=not args.no_resume, log_to_stdout=not args.quiet)
+    try:
+        config = from_dict(PPOTrainConfig, cfg)
+        summary = train_ppo(config, args.out, resume=not args.no_resume, log_to_stdout=not args.quiet)
+    except ConfigError as err:
+        raise SystemExit(f"error: {err}") from err
     resumed = f" (resumed from {summary['resumed_from']})" if summary["resumed_from"] else ""
     print(f"{config.category} PPO, perception {config.perception.source}, {config.n_envs} env(s){resumed}")
     print(f"  steps: {summary['num_timesteps']} in all, {summary['steps_this_run']} this run in "

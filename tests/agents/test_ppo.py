@@ -9,6 +9,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+import yaml
 
 import capt_env  # noqa: F401
 from agents.ppo.config import PPOTrainConfig
@@ -105,6 +106,11 @@ def test_train_save_reload_resume(tmp_path: Path) -> None:
     assert latest_checkpoint(run)[1] == 128
     assert not torch.equal(in_memory["params"], params_64)  # it trained on
     # already at the total: nothing more to learn
+    assert train_ppo(tiny(total_timesteps=128), run)["steps_this_run"] == 0
+    # a run saved before a config field existed resumes with that field's default
+    saved = yaml.safe_load((run / "config.yaml").read_text())
+    del saved["continue_after_success"], saved["perception"]["hinge_on_part_edge"]
+    (run / "config.yaml").write_text(yaml.safe_dump(saved))
     assert train_ppo(tiny(total_timesteps=128), run)["steps_this_run"] == 0
     # a resume may not change what is trained
     with pytest.raises(ConfigError, match="seed"):
