@@ -125,3 +125,21 @@ def test_saved_residual_model_runs_with_the_opener(tmp_path: Path,
     (tmp_path / "run" / "config.yaml").unlink()
     with pytest.raises(ValueError, match="residual"):
         PPOPolicy.load(tmp_path / "run" / "final.zip")
+
+
+def test_shipped_drawer_policy_opens_an_unseen_drawer() -> None:
+    """The shipped residual policy loads with its opener and opens test-split drawer seed 0 with
+    oracle perception (it did in the 50-episode benchmark, benchmarks/rollout_ppo_oracle.json)."""
+    from agents.ppo.policies import shipped_policy
+    from agents.scripted.rollout import run_episode
+
+    policy = PPOPolicy.load(shipped_policy("drawer_cabinet"))
+    assert policy.residual is not None and policy.obs_norm is not None
+    env = make_env("drawer_cabinet", {"source": "oracle", "every_k_steps": 5})
+    try:
+        result = run_episode(env, policy, seed=0)
+    finally:
+        env.close()
+    assert result.success and result.open_fraction >= 0.75
+    with pytest.raises(FileNotFoundError, match="drawer_cabinet"):
+        shipped_policy("toaster")
