@@ -11,28 +11,34 @@ from perception.yaml_config import require
 class ScriptedOpenerConfig:
     """Gains, offsets and targets of :class:`agents.scripted.opener.ScriptedOpener`.
 
-    Approach: pre-grasp ``pregrasp_offset`` m outside the grasp point along the part's outward
-    normal, then ``grasp_depth`` m past it. The approach direction points at least
-    ``vertical_hinge_pitch`` rad below horizontal for parts hinged about a near-vertical axis (the
-    axis within ``vertical_hinge_max_tilt`` rad of vertical: doors; the hand only yaws while
-    pulling) and ``approach_pitch`` rad for the others (drawers, oven doors, lids: the hand pitches
-    while pulling, so it starts nearer level); a level Panda hand near the table is beyond its wrist
-    limits. The fingers approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap
-    keeps a pitched fingertip off the surface a handle stands on). Moves are capped at
-    ``max_step_m`` / ``max_step_rad`` per control step; ``pos_tolerance`` / ``rot_tolerance`` end
-    a move, as do ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact).
-    ``close_steps`` steps close the gripper. Pulling leads the part by ``revolute_lead`` rad or
-    ``prismatic_lead`` m. The hand turns with a door about a vertical hinge, and by
-    ``wrist_follow`` of the part's angle about any other hinge (a grasped bar turns between the pads;
-    a hand turned fully with an oven door reaches the Panda's wrist limit). Pulling stops at
-    ``revolute_target`` rad / ``prismatic_target`` m, or when the state grew by less than
-    ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost
-    grip). The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than
-    ``slip_distance`` m from the part's perceived grasp point for ``slip_steps`` steps (longer than
-    the perception period, so one bad estimate, e.g. of a handle the hand now hides, is not a slip)
-    and its fingers are less than ``hold_gap`` m apart (closed on nothing; a gap means they hold
-    the handle, whatever the perceived grasp point says).
-    After release it backs off ``retreat_distance`` m.
+    Approach: pre-grasp ``pregrasp_offset`` m outside the grasp point along the part's outward normal,
+    then ``grasp_depth`` m past it. The approach direction points at least ``vertical_hinge_pitch``
+    rad below horizontal for parts hinged about a near-vertical axis (the axis within
+    ``vertical_hinge_max_tilt`` rad of vertical: doors; the hand only yaws while pulling) and
+    ``approach_pitch`` rad for the others (drawers, oven doors, lids: the hand pitches while pulling,
+    so it starts nearer level); a level Panda hand near the table is beyond its wrist limits. The
+    fingers approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a
+    pitched fingertip off the surface a handle stands on). Moves are capped at ``max_step_m`` /
+    ``max_step_rad`` per control step; ``pos_tolerance`` / ``rot_tolerance`` end a move, as do
+    ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact). A lid (a revolute
+    part whose grasp point opens within ``lid_max_tilt`` rad of straight up, like a closed laptop) is
+    gripped from above with the fingers ``lid_approach_gap`` m apart and closing along the hinge,
+    across its front lip, ``lid_edge_offset`` m beyond the grasp point away from the hinge (so the
+    fingers clear the lid's edge); the hand turns by ``lid_wrist_follow`` of the lid's angle (the
+    pinch lets the lip turn between the pads; a hand turned with the lid would point back at the
+    robot), and pulls to ``lid_revolute_target`` rad (past upright, so the lid does not rest on its
+    hinge's friction just short of the success angle). ``close_steps`` steps close the gripper.
+    Pulling leads the part by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a
+    door about a vertical hinge, and by ``wrist_follow`` of the part's angle about any other hinge (a
+    grasped bar turns between the pads; a hand turned fully with an oven door reaches the Panda's
+    wrist limit). Pulling stops at ``revolute_target`` rad / ``prismatic_target`` m, or when the state
+    grew by less than ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a
+    limit, or a lost grip). The gripper re-grasps (at most ``max_regrasps`` times) if it stays more
+    than ``slip_distance`` m from the part's perceived grasp point for ``slip_steps`` steps (longer
+    than the perception period, so one bad estimate, e.g. of a handle the hand now hides, is not a
+    slip) and its fingers are less than ``hold_gap`` m apart (closed on nothing; a gap means they hold
+    the handle, whatever the perceived grasp point says). After release it backs off
+    ``retreat_distance`` m.
     """
 
     pregrasp_offset: float = 0.08
@@ -47,6 +53,11 @@ class ScriptedOpenerConfig:
     move_timeout: int = 60
     blocked_steps: int = 6
     approach_gap: float = 0.045
+    lid_max_tilt: float = 0.5
+    lid_approach_gap: float = 0.08
+    lid_edge_offset: float = 0.015
+    lid_wrist_follow: float = 0.0
+    lid_revolute_target: float = 2.0
     close_steps: int = 8
     revolute_lead: float = 0.12
     prismatic_lead: float = 0.03
@@ -66,7 +77,7 @@ class ScriptedOpenerConfig:
     def validate(self) -> None:
         for key in ("pregrasp_offset", "max_step_m", "max_step_rad", "pos_tolerance", "rot_tolerance",
                     "revolute_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
-                    "revolute_target", "prismatic_target",
+                    "revolute_target", "prismatic_target", "lid_revolute_target",
                     "slip_distance", "hold_gap"):
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",
@@ -74,8 +85,13 @@ class ScriptedOpenerConfig:
             require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")
         require(0.0 < self.approach_gap <= 0.08,
                 f"approach_gap must be in (0, 0.08] m, got {self.approach_gap}")
-        require(0.0 <= self.wrist_follow <= 1.0, f"wrist_follow must be in [0, 1], got {self.wrist_follow}")
+        for key in ("wrist_follow", "lid_wrist_follow"):
+            value = getattr(self, key)
+            require(0.0 <= value <= 1.0, f"{key} must be in [0, 1], got {value}")
+        require(0.0 < self.lid_approach_gap <= 0.08,
+                f"lid_approach_gap must be in (0, 0.08] m, got {self.lid_approach_gap}")
+        require(self.lid_edge_offset >= 0, f"lid_edge_offset must be >= 0 m, got {self.lid_edge_offset}")
         require(self.max_regrasps >= 0, "max_regrasps must be >= 0")
-        for key in ("approach_pitch", "vertical_hinge_pitch", "vertical_hinge_max_tilt"):
+        for key in ("approach_pitch", "vertical_hinge_pitch", "vertical_hinge_max_tilt", "lid_max_tilt"):
             value = getattr(self, key)
             require(0 <= value <= 1.5, f"{key} must be in [0, 1.5] rad, got {value}")

@@ -15,7 +15,8 @@ Strategy, per episode:
    fingers closing perpendicular to the handle (revolute: along the radius from the axis, so a bar
    parallel to the hinge is enclosed; prismatic: vertically). The approach is pitched below
    horizontal by at least ``vertical_hinge_pitch`` (doors) or ``approach_pitch`` (other parts), as
-   the Panda's wrist cannot point level near the table.
+   the Panda's wrist cannot point level near the table. A lid (its grasp point opens upwards) is
+   gripped from above, the fingers closing along the hinge across its front lip (``is_lid``).
 2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper.
 4. ``PULL``: the part's state is measured by the hand itself while it holds the part (the grasp-time
    estimate plus the TCP's swept angle about the estimated axis, or its travel along it), every
@@ -94,6 +95,24 @@ def is_vertical_hinge(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool
     return abs(float(unit(est.direction)[2])) >= float(np.cos(cfg.vertical_hinge_max_tilt))
 
 
+def is_lid(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
+    """Whether ``est`` is a revolute part that opens upwards at its grasp point, within
+    ``lid_max_tilt`` rad of straight up (a closed lid: the hand comes down from above)."""
+    if est.joint_type != "revolute":
+        return False
+    return float(outward_normal(est)[2]) >= float(np.cos(cfg.lid_max_tilt))
+
+
+def grasp_target(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> np.ndarray:
+    """World point (3,) the TCP grips: the grasp point, moved ``lid_edge_offset`` m further from the
+    hinge on a lid (the fingers then pinch the front of the lip and clear the lid's edge)."""
+    if not is_lid(est, cfg):
+        return est.grasp_point
+    u = unit(est.direction)
+    radial = perpendicular(u, est.grasp_point - est.pivot)
+    return est.grasp_point if radial is None else est.grasp_point + cfg.lid_edge_offset * radial
+
+
 def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig) -> np.ndarray:
     """TCP rotation (3, 3) for grasping: approach along -n, fingers closing across the handle.
 
@@ -101,7 +120,11 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
     """
     n = outward_normal(est)
     approach = -n
-    if est.joint_type == "revolute":
+    if is_lid(est, cfg):
+        # a part lying flat and opening upwards (a lid): along the radius one finger would come down
+        # on the part itself, so the fingers close along the hinge, across the lid's front lip
+        closing = perpendicular(approach, unit(est.direction))
+    elif est.joint_type == "revolute":
         closing = perpendicular(approach, est.grasp_point - est.pivot)
     else:
         closing = perpendicular(approach, _UP)
@@ -149,6 +172,7 @@ class ScriptedOpener:
         self._grasp_r: np.ndarray | None = None
         self._grasp_state = 0.0
         self._target_r: np.ndarray | None = None
+        self._lid = False
         self._history: list[float] = []
         self._slip_count = 0
         self._retreat_from: np.ndarray | None = None
@@ -205,12 +229,15 @@ class ScriptedOpener:
         if self.phase in (Phase.PREGRASP, Phase.APPROACH):
             if self._target_r is None or self.phase == Phase.PREGRASP and self.phase_steps == 1:
                 self._target_r = grasp_rotation(est, r, cfg)
+                self._lid = is_lid(est, cfg)
             approach = self._target_r[:, 2]
+            point = grasp_target(est, cfg) if self._lid else est.grasp_point
             if self.phase == Phase.PREGRASP:
-                goal = est.grasp_point - approach * cfg.pregrasp_offset
+                goal = point - approach * cfg.pregrasp_offset
             else:
-                goal = est.grasp_point + approach * cfg.grasp_depth
-            action, perr, rerr = self._goto(p, r, goal, self._target_r, gripper_action(cfg.approach_gap))
+                goal = point + approach * cfg.grasp_depth
+            gap = cfg.lid_approach_gap if self._lid else cfg.approach_gap
+            action, perr, rerr = self._goto(p, r, goal, self._target_r, gripper_action(gap))
             if self._reached(p, perr, rerr):
                 self._set(Phase.APPROACH if self.phase == Phase.PREGRASP else Phase.CLOSE)
             return action
@@ -266,7 +293,10 @@ class ScriptedOpener:
         else:
             state = self._grasp_state + float((p - self._grasp_p) @ u)
         self._history.append(state)
-        target = cfg.revolute_target if revolute else cfg.prismatic_target
+        if revolute:
+            target = cfg.lid_revolute_target if self._lid else cfg.revolute_target
+        else:
+            target = cfg.prismatic_target
         min_progress = cfg.stall_progress if revolute else cfg.stall_progress_m
         stalled = (len(self._history) > cfg.stall_steps
                    and self._history[-1] - self._history[-1 - cfg.stall_steps] < min_progress)
@@ -291,7 +321,10 @@ class ScriptedOpener:
         if revolute:
             delta = state - self._grasp_state + cfg.revolute_lead
             p_des = est.pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - est.pivot)
-            follow = 1.0 if is_vertical_hinge(est, cfg) else cfg.wrist_follow
+            if is_vertical_hinge(est, cfg):
+                follow = 1.0
+            else:
+                follow = cfg.lid_wrist_follow if self._lid else cfg.wrist_follow
             r_des = axis_angle_matrix(u, follow * delta) @ self._grasp_r
         else:
             delta = state - self._grasp_state + cfg.prismatic_lead

@@ -9,6 +9,12 @@ from perception.yaml_config import ConfigError, require
 
 Split = Literal["train", "val", "test", "all"]
 
+DEFAULT_OBJECT_XY: tuple[float, float] = (0.3, 0.0)
+"""World (x, y) metres of an object's bounding-box centre when neither the task nor its category
+says otherwise."""
+CATEGORY_OBJECT_XY: dict[str, tuple[float, float]] = {"laptop": (-0.08, 0.0)}
+"""Per-category placement (see :class:`TaskConfig`)."""
+
 
 @dataclass(frozen=True)
 class CameraConfig:
@@ -59,7 +65,11 @@ class TaskConfig:
     Placement (world frame, metres/radians): the object's bounding-box centre is put at
     ``object_xy`` +- ``object_xy_noise`` on the table top, its front facing the robot, turned by a
     yaw uniform in +-``yaw_noise``. The Panda's base is at (-0.615, 0) and its resting hand near
-    x = 0; the default 0.3 m keeps deep objects (ovens, cabinets) clear of the hand at reset.
+    x = 0. ``object_xy`` None (the default) means the category's placement
+    (:data:`CATEGORY_OBJECT_XY`, else :data:`DEFAULT_OBJECT_XY`): 0.3 m keeps deep objects (ovens,
+    cabinets) clear of the hand at reset; a laptop sits under the resting hand at -0.08 m, because
+    its lid's lip, swung up to vertical 0.2-0.3 m behind where it started, is beyond the Panda's
+    reach from 0.3 m.
 
     Joint states at reset: the target joint starts at a fraction of its range uniform in
     ``target_init_fraction``; other joints uniform in ``other_init_fraction`` of their ranges.
@@ -76,7 +86,7 @@ class TaskConfig:
     scale: float = 1.0
     split: Split = "train"
     instance_ids: tuple[int, ...] | None = None
-    object_xy: tuple[float, float] = (0.3, 0.0)
+    object_xy: tuple[float, float] | None = None
     object_xy_noise: tuple[float, float] = (0.05, 0.05)
     yaw_noise: float = 0.2
     target_init_fraction: tuple[float, float] = (0.0, 0.05)
@@ -107,6 +117,15 @@ class TaskConfig:
         require(0.0 < self.success_fraction <= 1.0, "success_fraction must be in (0, 1]")
         require(self.yaw_noise >= 0, "yaw_noise must be >= 0")
         require(all(n >= 0 for n in self.object_xy_noise), "object_xy_noise must be >= 0")
+        require(self.object_xy is None or len(self.object_xy) == 2,
+                f"object_xy must be [x, y] metres or null, got {self.object_xy}")
+
+    def placement_xy(self) -> tuple[float, float]:
+        """World (x, y) metres of the object's bounding-box centre before noise: ``object_xy``, or
+        the category's default placement when it is None."""
+        if self.object_xy is not None:
+            return (float(self.object_xy[0]), float(self.object_xy[1]))
+        return CATEGORY_OBJECT_XY.get(self.category or "", DEFAULT_OBJECT_XY)
         require(len(self.cameras) >= 1, "at least one camera is needed")
         names = [c.name for c in self.cameras]
         require(len(set(names)) == len(names), f"camera names must be unique, got {names}")

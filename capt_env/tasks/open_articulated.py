@@ -125,7 +125,7 @@ class OpenArticulatedEnv(BaseEnv):
     # ------------------------------------------------------------------ scene
     @property
     def _default_sensor_configs(self) -> list[MSCameraConfig]:
-        x, y = self.task_config.object_xy
+        x, y = self.task_config.placement_xy()
         target = np.array([x, y, 0.15])
         configs = []
         for cam in self.task_config.cameras:
@@ -181,11 +181,11 @@ class OpenArticulatedEnv(BaseEnv):
             self._aim_cameras(placement, float(np.asarray(yaw).reshape(-1)[0]), self._episode_rng)
 
     def _placement(self, noise_xy: torch.Tensor, yaw: torch.Tensor) -> _Placement:
-        """Root pose putting the object's bounding-box centre at ``object_xy + noise`` on the table."""
+        """Root pose putting the object's bounding-box centre at ``placement_xy() + noise`` on the table."""
         obj = self.object
         lo, hi = obj.aabb
         centre_local = torch.as_tensor((lo + hi) / 2, dtype=torch.float32)
-        target_xy = torch.as_tensor(self.task_config.object_xy, dtype=torch.float32) + noise_xy
+        target_xy = torch.as_tensor(self.task_config.placement_xy(), dtype=torch.float32) + noise_xy
         c, s = torch.cos(yaw), torch.sin(yaw)
         rot_cx = c * centre_local[0] - s * centre_local[1]
         rot_cy = s * centre_local[0] + c * centre_local[1]

@@ -8,7 +8,7 @@ import pytest
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
 from agents.scripted.geometry import axis_angle_matrix, swept_angle
-from agents.scripted.opener import outward_normal
+from agents.scripted.opener import grasp_rotation, grasp_target, is_lid, outward_normal
 from agents.scripted.rollout import make_env, run_episode
 from capt_env.wrappers.estimate import JointAxisEstimate
 from perception.yaml_config import ConfigError, from_dict
@@ -19,6 +19,38 @@ def test_outward_normal_of_a_door_points_at_the_robot() -> None:
     est = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]), 0.0,
                             np.array([-0.1, 0.2, 0.3]))
     np.testing.assert_allclose(outward_normal(est), [-1.0, 0.0, 0.0], atol=1e-9)
+
+
+def _closed_laptop() -> JointAxisEstimate:
+    # hinge along +y at the back edge (x = 0.15, z = 0.03), lip on the front edge (x = -0.1)
+    return JointAxisEstimate("revolute", np.array([0.0, 1.0, 0.0]), np.array([0.15, 0.0, 0.03]), 0.0,
+                             np.array([-0.1, 0.05, 0.03]))
+
+
+def test_a_closed_lid_is_gripped_from_above_across_its_lip() -> None:
+    cfg = ScriptedOpenerConfig()
+    est = _closed_laptop()
+    assert is_lid(est, cfg)
+    np.testing.assert_allclose(outward_normal(est), [0.0, 0.0, 1.0], atol=1e-9)
+    frame = grasp_rotation(est, np.eye(3), cfg)
+    np.testing.assert_allclose(frame[:, 2], [0.0, 0.0, -1.0], atol=1e-9)  # approach: straight down
+    assert abs(frame[:, 1] @ np.array([0.0, 1.0, 0.0])) == pytest.approx(1.0)  # fingers close along y
+    # the TCP grips lid_edge_offset beyond the grasp point, away from the hinge (towards -x)
+    np.testing.assert_allclose(grasp_target(est, cfg), est.grasp_point + [-cfg.lid_edge_offset, 0, 0],
+                               atol=1e-9)
+
+
+def test_doors_and_drawers_are_not_lids() -> None:
+    cfg = ScriptedOpenerConfig()
+    door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]), 0.0,
+                             np.array([-0.1, 0.2, 0.3]))
+    drawer = JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.zeros(3), 0.0,
+                               np.array([-0.2, 0.0, 0.1]))
+    assert not is_lid(door, cfg) and not is_lid(drawer, cfg)
+    np.testing.assert_allclose(grasp_target(door, cfg), door.grasp_point)
+    # a door's fingers close along the radius from the hinge (across a vertical bar handle)
+    frame = grasp_rotation(door, np.eye(3), cfg)
+    assert abs(frame[:, 1] @ np.array([0.0, 1.0, 0.0])) == pytest.approx(1.0, abs=1e-6)
 
 
 def test_swept_angle_is_signed_and_ignores_travel_along_the_axis() -> None:
@@ -39,6 +71,16 @@ def test_opens_a_washing_machine_door_with_oracle_perception() -> None:
     env = make_env("washing_machine", {"source": "oracle"})
     try:
         result = run_episode(env, ScriptedOpener(), seed=0, max_steps=150)
+    finally:
+        env.close()
+    assert result.success, result
+    assert result.open_fraction >= 0.75
+
+
+def test_opens_a_laptop_lid_with_oracle_perception() -> None:
+    env = make_env("laptop", {"source": "oracle"})
+    try:
+        result = run_episode(env, ScriptedOpener(), seed=3, max_steps=200)
     finally:
         env.close()
     assert result.success, result

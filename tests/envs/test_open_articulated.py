@@ -244,6 +244,25 @@ def test_generic_id_takes_category() -> None:
         env.close()
 
 
+def test_placement_defaults_per_category_and_task_overrides() -> None:
+    from capt_env.tasks.config import TaskConfig
+
+    assert TaskConfig(category="oven").placement_xy() == (0.3, 0.0)
+    assert TaskConfig(category="laptop").placement_xy() == (-0.08, 0.0)
+    assert TaskConfig(category="laptop", object_xy=(0.2, 0.1)).placement_xy() == (0.2, 0.1)
+    env = gym.make(GENERIC_ID, obs_mode="state",
+                   task={"category": "laptop", "object_xy_noise": [0.0, 0.0], "yaw_noise": 0.0,
+                         "cameras": [CAMERA]})
+    try:
+        env.reset(seed=0)
+        lo, hi = env.unwrapped.object.aabb
+        root = env.unwrapped.articulation.pose.p[0].cpu().numpy()
+        np.testing.assert_allclose(root[:2] + (np.asarray(lo) + np.asarray(hi))[:2] / 2, [-0.08, 0.0],
+                                   atol=1e-5)
+    finally:
+        env.close()
+
+
 def test_bad_inputs_give_clear_errors(tmp_path) -> None:
     with pytest.raises(ConfigError, match="unknown category"):
         gym.make(GENERIC_ID, task={"category": "toaster"})
