@@ -52,12 +52,13 @@ def unit(v: np.ndarray) -> np.ndarray:
 
 
 def grasp_point_of_part(part_points: np.ndarray, joint_type: str, direction: np.ndarray,
-                        pivot: np.ndarray, quantile: float = 0.97) -> np.ndarray:
+                        pivot: np.ndarray, quantile: float = 0.97, band: float = 0.01) -> np.ndarray:
     """A grasp point on a moving part from its points (M, 3), world frame, metres.
 
     Revolute: the far edge, i.e. the mean of the points whose distance to the axis is at least the
-    ``quantile`` of those distances (a handle sticks out, so it wins when present). Prismatic: the
-    front-most points along ``direction`` (the front face and its handle), same quantile rule.
+    ``quantile`` of those distances and within ``band`` metres of the farthest (their 99.5th
+    percentile), so a lip or handle sticking out past the edge wins over the edge's full length.
+    Prismatic: the front-most points along ``direction`` (the front face and its handle), same rule.
     """
     if len(part_points) == 0:
         raise ValueError("the moving part has no points")
@@ -68,5 +69,6 @@ def grasp_point_of_part(part_points: np.ndarray, joint_type: str, direction: np.
         score = np.linalg.norm(rel - np.outer(along, u), axis=1)
     else:
         score = along
-    keep = score >= np.quantile(score, quantile)
+    floor = max(float(np.quantile(score, quantile)), float(np.quantile(score, 0.995)) - band)
+    keep = score >= floor
     return part_points[keep].mean(axis=0)

@@ -62,6 +62,17 @@ def test_canonical_pivot_and_far_edge_grasp_point() -> None:
     assert g[0] > 0.38
 
 
+def test_far_edge_grasp_point_finds_a_lids_lip() -> None:
+    # a closed lid (x in [-0.23, 0], y in [-0.15, 0.15], hinge along y at x = 0) with a 6 cm lip
+    # overhanging its front edge by 2 cm at y in [0.05, 0.11]; points uniform by area
+    rng = np.random.default_rng(1)
+    lid = np.stack([rng.uniform(-0.23, 0.0, 1000), rng.uniform(-0.15, 0.15, 1000), np.zeros(1000)], axis=1)
+    lip = np.stack([rng.uniform(-0.25, -0.23, 17), rng.uniform(0.05, 0.11, 17), np.zeros(17)], axis=1)
+    g = grasp_point_of_part(np.concatenate([lid, lip]), "revolute", np.array([0.0, 1.0, 0.0]), np.zeros(3))
+    assert abs(g[1] - 0.08) < 0.02, g  # on the lip, not the middle of the front edge
+    assert g[0] < -0.235
+
+
 def _oven_like_scene(rng: np.random.Generator, with_handle: bool) -> tuple[np.ndarray, np.ndarray]:
     """A door in the plane x = 0 (y in [-0.2, 0.2], z in [0, 0.4]) on a body behind it (x > 0), and
     optionally a bar handle 3 cm in front of the door (x = -0.03) at z = 0.35, y in [-0.1, 0.1]."""
