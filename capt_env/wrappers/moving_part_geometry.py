@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import ConvexHull, QhullError
 
 from capt_env.wrappers.estimate import unit
 from capt_env.wrappers.plane_fit import ransac_plane
@@ -95,6 +96,61 @@ def opening_direction(joint_type: str, direction: np.ndarray, pivot: np.ndarray,
     u = unit(direction)
     motion = np.cross(u, np.asarray(grasp, dtype=np.float64) - pivot) if joint_type == "revolute" else u
     return -u if float(motion @ outward) < 0.0 else u
+
+
+def edge_aligned_direction(direction: np.ndarray, plane: PartPlane, part_points: np.ndarray,
+                           max_turn: float = 0.6, min_fill: float = 0.85,
+                           band: float = 0.01, min_aspect: float = 0.25) -> np.ndarray:
+    """``direction`` (3,) turned onto the nearer edge of a rectangular part: unit (3,), world frame.
+
+    A door's or lid's hinge runs along one of its edges. The part's points within ``band`` m of its
+    plane are fitted with their minimum-area bounding rectangle (in the plane); when their convex
+    hull fills at least ``min_fill`` of it (a rectangle, not a round washing-machine door) and the
+    rectangle's edge nearest to ``direction``'s in-plane component is at most ``max_turn`` rad away,
+    that edge's direction is returned, with ``direction``'s sign. Otherwise (or when ``direction``
+    is more than 60 deg out of the plane, or there are fewer than 10 such points) ``direction`` is
+    returned unchanged, as it is for a bar (points spreading less than ``min_aspect`` as much across
+    their main in-plane direction as along it: an eyeglasses temple). A single view's estimate of a
+    lid's hinge often errs within the lid's plane by 5-25 deg, which moves the lid's far edge, where
+    the grasp point is looked for, to a corner.
+    """
+    u = unit(direction)
+    along = u - float(u @ plane.outward) * plane.outward
+    if np.linalg.norm(along) < np.sin(np.radians(30.0)):
+        return u
+    near = np.abs((part_points - plane.centre) @ plane.outward) <= band
+    uv = (part_points[near] - plane.centre) @ plane.in_plane.T
+    if len(uv) < 10:
+        return u
+    spread = np.linalg.svd(uv - uv.mean(axis=0), compute_uv=False)
+    if spread[1] < min_aspect * spread[0]:
+        return u
+    try:
+        hull = ConvexHull(uv)
+    except QhullError:  # collinear points: no area
+        return u
+    corners = uv[hull.vertices]
+    best_area, best_angle = np.inf, 0.0
+    for a, b in zip(corners, np.roll(corners, -1, axis=0), strict=True):
+        angle = float(np.arctan2(b[1] - a[1], b[0] - a[0]))
+        c, s = np.cos(angle), np.sin(angle)
+        rotated = corners @ np.array([[c, -s], [s, c]])
+        area = float(np.prod(rotated.max(axis=0) - rotated.min(axis=0)))
+        if area < best_area:
+            best_area, best_angle = area, angle
+    if best_area <= 0.0 or hull.volume < min_fill * best_area:  # hull.volume is its area in 2-D
+        return u
+    target = np.array([float(along @ plane.in_plane[0]), float(along @ plane.in_plane[1])])
+    best: np.ndarray | None = None
+    for angle in (best_angle, best_angle + np.pi / 2):
+        edge = np.array([np.cos(angle), np.sin(angle)])
+        edge = edge if float(edge @ target) >= 0 else -edge
+        turn = float(np.arccos(np.clip(edge @ unit(target), -1.0, 1.0)))
+        if turn <= max_turn:
+            best = edge
+    if best is None:
+        return u
+    return unit(best[0] * plane.in_plane[0] + best[1] * plane.in_plane[1])
 
 
 def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, part_points: np.ndarray,

@@ -20,7 +20,13 @@ from capt_env.wrappers.estimate import (
     unit,
 )
 from capt_env.wrappers.estimate_fusion import EstimateFusion
-from capt_env.wrappers.moving_part_geometry import handle_point, hinge_on_edge, opening_direction, part_plane
+from capt_env.wrappers.moving_part_geometry import (
+    edge_aligned_direction,
+    handle_point,
+    hinge_on_edge,
+    opening_direction,
+    part_plane,
+)
 
 
 class PerceptionSource(Protocol):
@@ -136,6 +142,8 @@ class CaptSource:
                 moving = points[mask]
         direction = unit(joint.direction)
         plane = part_plane(points, moving)
+        if plane is not None and self.hinge_on_part_edge and joint.type == "revolute":
+            direction = edge_aligned_direction(direction, plane, moving)
         grasp = None if plane is None else handle_point(points, moving, plane=plane)
         if grasp is None:
             grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))

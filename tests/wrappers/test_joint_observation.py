@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part
+from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part, unit
 from capt_env.wrappers.joint_observation import (
     OBSERVATION_SIZE,
     build_dict,
@@ -14,7 +14,13 @@ from capt_env.wrappers.joint_observation import (
     flatten,
     observation_layout,
 )
-from capt_env.wrappers.moving_part_geometry import handle_point, hinge_on_edge, opening_direction, part_plane
+from capt_env.wrappers.moving_part_geometry import (
+    edge_aligned_direction,
+    handle_point,
+    hinge_on_edge,
+    opening_direction,
+    part_plane,
+)
 
 
 def _estimate() -> JointAxisEstimate:
@@ -129,6 +135,40 @@ def test_opening_direction_turns_the_axis_so_the_part_moves_away_from_its_body()
     # a drawer pulls out along the outward normal whichever sign was estimated
     u = opening_direction("prismatic", np.array([1.0, 0.0, 0.0]), pivot, grasp, plane.outward)
     np.testing.assert_allclose(u, [-1.0, 0.0, 0.0])
+
+
+def _flat_part(rng: np.random.Generator, inside, n: int = 1500) -> np.ndarray:
+    """Points of a flat part in the plane z = 0 where ``inside(x, y)``, over the square +-0.25 m."""
+    xy = rng.uniform(-0.25, 0.25, size=(n, 2))
+    xy = xy[inside(xy[:, 0], xy[:, 1])]
+    return np.column_stack([xy, rng.normal(0.0, 0.002, len(xy))])
+
+
+def test_edge_aligned_direction_snaps_onto_a_rectangles_edge_and_leaves_a_disc_alone() -> None:
+    rng = np.random.default_rng(2)
+    yaw = np.radians(7.0)
+    c, s = np.cos(yaw), np.sin(yaw)
+    # a 0.34 x 0.22 m lid turned 7 deg about z (its hinge edge along (-sin 7, cos 7, 0))
+    lid = _flat_part(rng, lambda x, y: (np.abs(c * x + s * y) < 0.11) & (np.abs(-s * x + c * y) < 0.17))
+    body = lid - np.array([0.0, 0.0, 0.03])  # the base under it, for the outward normal
+    plane = part_plane(np.concatenate([lid, body]), lid)
+    assert plane is not None
+    true_axis = np.array([-s, c, 0.0])
+    for err in (-25.0, 0.0, 12.0):  # CAPT's in-plane error, degrees
+        e = np.radians(err)
+        estimate = np.array([-np.sin(yaw + e), np.cos(yaw + e), 0.05])
+        snapped = edge_aligned_direction(estimate, plane, lid)
+        assert np.degrees(np.arccos(abs(snapped @ true_axis))) < 1.0, (err, snapped)
+        assert snapped @ true_axis > 0  # the sign is the estimate's
+    # 45 deg off lies between the edges: left alone
+    off = np.array([-np.sin(yaw + 0.8), np.cos(yaw + 0.8), 0.0])
+    np.testing.assert_allclose(edge_aligned_direction(off, plane, lid), off, atol=1e-9)
+    # a round door has no edge to snap to
+    disc = _flat_part(rng, lambda x, y: x**2 + y**2 < 0.2**2)
+    plane = part_plane(np.concatenate([disc, disc - [0.0, 0.0, 0.03]]), disc)
+    assert plane is not None
+    estimate = unit(np.array([0.2, 1.0, 0.0]))
+    np.testing.assert_allclose(edge_aligned_direction(estimate, plane, disc), estimate, atol=1e-9)
 
 
 def test_hinge_on_edge_moves_a_far_off_line_onto_the_door_edge_away_from_the_handle() -> None:
