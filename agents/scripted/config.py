@@ -24,8 +24,9 @@ class ScriptedOpenerConfig:
     part whose grasp point opens within ``lid_max_tilt`` rad of straight up, like a closed laptop) is
     gripped from above with the fingers ``lid_approach_gap`` m apart and closing along the hinge,
     across its front lip, ``lid_edge_offset`` m beyond the grasp point away from the hinge (so the
-    fingers clear the lid's edge); the hand turns by ``lid_wrist_follow`` of the lid's angle (the
-    pinch lets the lip turn between the pads; a hand turned with the lid would point back at the
+    pads clear the lid's edge whether the grasp point is the lip's centre, as with ground truth, or
+    the outer band of its points, as from CAPT); the hand turns by ``lid_wrist_follow`` of the lid's
+    angle (the pinch lets the lip turn between the pads; a hand turned with the lid would point back at the
     robot), and pulls to ``lid_revolute_target`` rad (past upright, so the lid does not rest on its
     hinge's friction just short of the success angle). ``close_steps`` steps close the gripper.
     Pulling leads the part by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a
@@ -55,7 +56,7 @@ class ScriptedOpenerConfig:
     approach_gap: float = 0.045
     lid_max_tilt: float = 0.5
     lid_approach_gap: float = 0.08
-    lid_edge_offset: float = 0.015
+    lid_edge_offset: float = 0.005
     lid_wrist_follow: float = 0.0
     lid_revolute_target: float = 2.0
     close_steps: int = 8
