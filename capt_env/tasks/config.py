@@ -119,13 +119,6 @@ class TaskConfig:
         require(all(n >= 0 for n in self.object_xy_noise), "object_xy_noise must be >= 0")
         require(self.object_xy is None or len(self.object_xy) == 2,
                 f"object_xy must be [x, y] metres or null, got {self.object_xy}")
-
-    def placement_xy(self) -> tuple[float, float]:
-        """World (x, y) metres of the object's bounding-box centre before noise: ``object_xy``, or
-        the category's default placement when it is None."""
-        if self.object_xy is not None:
-            return (float(self.object_xy[0]), float(self.object_xy[1]))
-        return CATEGORY_OBJECT_XY.get(self.category or "", DEFAULT_OBJECT_XY)
         require(len(self.cameras) >= 1, "at least one camera is needed")
         names = [c.name for c in self.cameras]
         require(len(set(names)) == len(names), f"camera names must be unique, got {names}")
@@ -134,3 +127,10 @@ class TaskConfig:
         if self.instance_ids is not None:
             require(len(self.instance_ids) > 0, "instance_ids must not be empty")
             require(all(i >= 0 for i in self.instance_ids), "instance_ids must be >= 0")
+
+    def placement_xy(self) -> tuple[float, float]:
+        """World (x, y) metres of the object's bounding-box centre before noise: ``object_xy``, or
+        the category's default placement when it is None."""
+        if self.object_xy is not None:
+            return (float(self.object_xy[0]), float(self.object_xy[1]))
+        return CATEGORY_OBJECT_XY.get(self.category or "", DEFAULT_OBJECT_XY)

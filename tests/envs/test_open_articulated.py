@@ -272,6 +272,10 @@ def test_bad_inputs_give_clear_errors(tmp_path) -> None:
         make("laptop", task={"target_init_fraction": [0.5, 1.5]})
     with pytest.raises(ConfigError, match="unknown key"):
         make("laptop", task={"colour": "red"})
+    with pytest.raises(ConfigError, match="at least one camera"):
+        make("laptop", task={"cameras": []})
+    with pytest.raises(ConfigError, match="object_xy"):
+        make("laptop", task={"object_xy": [0.1, 0.2, 0.3]})
     with pytest.raises(FileNotFoundError, match="missing.urdf"):
         gym.make(GENERIC_ID, task={"object": str(tmp_path / "missing.urdf")})
     with pytest.raises(ValueError, match="instance_id"):
