@@ -143,3 +143,18 @@ def test_shipped_drawer_policy_opens_an_unseen_drawer() -> None:
     assert result.success and result.open_fraction >= 0.75
     with pytest.raises(FileNotFoundError, match="drawer_cabinet"):
         shipped_policy("toaster")
+
+
+def test_shipped_laptop_policy_opens_an_unseen_laptop() -> None:
+    """As above for the laptop: test-split seed 3 opened in benchmarks/rollout_ppo_oracle_laptop.json."""
+    from agents.ppo.policies import shipped_policy
+    from agents.scripted.rollout import run_episode
+
+    policy = PPOPolicy.load(shipped_policy("laptop"))
+    assert policy.residual is not None
+    env = make_env("laptop", {"source": "oracle", "every_k_steps": 5})
+    try:
+        result = run_episode(env, policy, seed=3)
+    finally:
+        env.close()
+    assert result.success and result.open_fraction >= 0.75
