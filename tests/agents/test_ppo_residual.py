@@ -127,34 +127,25 @@ def test_saved_residual_model_runs_with_the_opener(tmp_path: Path,
         PPOPolicy.load(tmp_path / "run" / "final.zip")
 
 
-def test_shipped_drawer_policy_opens_an_unseen_drawer() -> None:
-    """The shipped residual policy loads with its opener and opens test-split drawer seed 0 with
-    oracle perception (it did in the 50-episode benchmark, benchmarks/rollout_ppo_oracle.json)."""
+@pytest.mark.parametrize(("category", "seed"), [("drawer_cabinet", 0), ("laptop", 3)])
+def test_shipped_policy_opens_an_unseen_instance(category: str, seed: int) -> None:
+    """A shipped residual policy loads with its opener and opens a test-split instance with oracle
+    perception (each did in its 50-episode benchmark: benchmarks/rollout_ppo_oracle*.json)."""
     from agents.ppo.policies import shipped_policy
     from agents.scripted.rollout import run_episode
 
-    policy = PPOPolicy.load(shipped_policy("drawer_cabinet"))
+    policy = PPOPolicy.load(shipped_policy(category))
     assert policy.residual is not None and policy.obs_norm is not None
-    env = make_env("drawer_cabinet", {"source": "oracle", "every_k_steps": 5})
+    env = make_env(category, {"source": "oracle", "every_k_steps": 5})
     try:
-        result = run_episode(env, policy, seed=0)
+        result = run_episode(env, policy, seed=seed)
     finally:
         env.close()
     assert result.success and result.open_fraction >= 0.75
+
+
+def test_unknown_shipped_policy_names_the_shipped_ones() -> None:
+    from agents.ppo.policies import shipped_policy
+
     with pytest.raises(FileNotFoundError, match="drawer_cabinet"):
         shipped_policy("toaster")
-
-
-def test_shipped_laptop_policy_opens_an_unseen_laptop() -> None:
-    """As above for the laptop: test-split seed 3 opened in benchmarks/rollout_ppo_oracle_laptop.json."""
-    from agents.ppo.policies import shipped_policy
-    from agents.scripted.rollout import run_episode
-
-    policy = PPOPolicy.load(shipped_policy("laptop"))
-    assert policy.residual is not None
-    env = make_env("laptop", {"source": "oracle", "every_k_steps": 5})
-    try:
-        result = run_episode(env, policy, seed=3)
-    finally:
-        env.close()
-    assert result.success and result.open_fraction >= 0.75
