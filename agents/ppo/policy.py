@@ -13,10 +13,16 @@ from typing import Any
 import numpy as np
 import yaml
 from stable_baselines3 import PPO
+from stable_baselines3.common.running_mean_std import RunningMeanStd
 from stable_baselines3.common.vec_env import VecNormalize
 
 from agents.ppo.residual import RESIDUAL_OBSERVATION_SIZE, ResidualComposer
 from agents.ppo.train import CONFIG_FILE, vecnormalize_path
+
+CONSTANT_FEATURE_VAR = 1e-6
+"""Training variance under which an observation feature counts as constant (see :class:`PPOPolicy`):
+the running statistics leave ~1e-9 (their prior, variance 1 at count 1e-4) on a feature that never
+changed; the least-varying real feature of the shipped policies has ~4e-5."""
 
 
 def run_config_of(model_path: str | Path) -> dict[str, Any] | None:
@@ -37,6 +43,12 @@ class PPOPolicy:
     :param obs_norm: its ``VecNormalize`` statistics (observations are normalised with them, in
         evaluation mode: the statistics stay fixed), or None when trained without normalisation.
     :param residual: for a residual model, the composer that runs the scripted opener beside it.
+
+    Features that never varied in training (variance below ``CONSTANT_FEATURE_VAR`` in the
+    normalisation statistics: the confidence under the oracle sources, which is always 1, and the
+    joint type of a single-joint-type category) are pinned to their training value. VecNormalize
+    would divide any change of them by ``sqrt(epsilon)`` and saturate its clip at +-10, an input the
+    policy never saw: CAPT's confidence below 1 did exactly that to the laptop's residual policy.
     """
 
     def __init__(self, model: PPO, obs_norm: VecNormalize | None = None,
@@ -48,8 +60,16 @@ class PPOPolicy:
         self.model = model
         self.obs_norm = obs_norm
         self.residual = residual
+        self._pinned: np.ndarray | None = None
         if obs_norm is not None:
             obs_norm.training = False
+            rms = obs_norm.obs_rms
+            if not isinstance(rms, RunningMeanStd):
+                raise ValueError("PPOPolicy takes flat (Box) observations; these statistics are "
+                                 f"{type(rms).__name__}")
+            constant = np.asarray(rms.var) < CONSTANT_FEATURE_VAR
+            self._pinned = np.flatnonzero(constant)
+            self._pinned_values = np.asarray(rms.mean, dtype=np.float32)[constant]
 
     @classmethod
     def load(cls, path: str | Path, vecnormalize: str | Path | None = None,
@@ -97,6 +117,9 @@ class PPOPolicy:
         if self.residual is not None:
             x = self.residual.observe(x, info)
         if self.obs_norm is not None:
+            if self._pinned is not None and self._pinned.size:
+                x = x.copy()
+                x[..., self._pinned] = self._pinned_values
             x = self.obs_norm.normalize_obs(x).astype(np.float32)
         action, _ = self.model.predict(x, deterministic=True)
         action = np.asarray(action, dtype=np.float32)

@@ -144,6 +144,30 @@ def test_shipped_policy_opens_an_unseen_instance(category: str, seed: int) -> No
     assert result.success and result.open_fraction >= 0.75
 
 
+def test_features_constant_in_training_are_pinned(first_obs: tuple[np.ndarray, dict]) -> None:
+    """The laptop's policy was trained with oracle confidence 1; CAPT's lower confidence must not
+    change its action (unpinned, VecNormalize would turn 0.6 into -10 standard deviations)."""
+    from agents.ppo.policies import shipped_policy
+    from capt_env.wrappers.joint_observation import observation_layout
+
+    policy = PPOPolicy.load(shipped_policy("laptop"))
+    confidence = observation_layout()["confidence"]
+    assert confidence.start in policy._pinned
+    obs, info = first_obs
+    actions = []
+    for value in (1.0, 0.6):
+        x = obs.copy()
+        x[confidence] = value
+        policy.reset()
+        actions.append(policy.act(x, info))
+    np.testing.assert_array_equal(actions[0], actions[1])
+    # a feature that did vary (the TCP position) still moves the action
+    x = obs.copy()
+    x[observation_layout()["tcp_pose"].start] += 0.05
+    policy.reset()
+    assert not np.array_equal(policy.act(x, info), actions[0])
+
+
 def test_unknown_shipped_policy_names_the_shipped_ones() -> None:
     from agents.ppo.policies import shipped_policy
 
