@@ -12,34 +12,36 @@ class ScriptedOpenerConfig:
     """Gains, offsets and targets of :class:`agents.scripted.opener.ScriptedOpener`.
 
     Approach: pre-grasp ``pregrasp_offset`` m outside the grasp point along the part's outward normal,
-    then ``grasp_depth`` m past it. The approach direction points at least ``vertical_hinge_pitch``
-    rad below horizontal for parts hinged about a near-vertical axis (the axis within
+    then ``grasp_depth`` m past it. The approach direction points at least ``vertical_hinge_pitch`` rad
+    below horizontal for parts hinged about a near-vertical axis (the axis within
     ``vertical_hinge_max_tilt`` rad of vertical: doors; the hand only yaws while pulling) and
-    ``approach_pitch`` rad for the others (drawers, oven doors, lids: the hand pitches while pulling,
-    so it starts nearer level); a level Panda hand near the table is beyond its wrist limits. The
-    fingers approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a
-    pitched fingertip off the surface a handle stands on). Moves are capped at ``max_step_m`` /
-    ``max_step_rad`` per control step; ``pos_tolerance`` / ``rot_tolerance`` end a move, as do
-    ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact). A lid (a revolute
-    part whose grasp point opens within ``lid_max_tilt`` rad of straight up, like a closed laptop) is
-    gripped from above with the fingers ``lid_approach_gap`` m apart and closing along the hinge,
-    across its front lip, ``lid_edge_offset`` m beyond the grasp point away from the hinge (so the
-    pads clear the lid's edge whether the grasp point is the lip's centre, as with ground truth, or
-    the outer band of its points, as from CAPT); the hand turns by ``lid_wrist_follow`` of the lid's
-    angle (the pinch lets the lip turn between the pads; a hand turned with the lid would point back at the
-    robot), and pulls to ``lid_revolute_target`` rad (past upright, so the lid does not rest on its
-    hinge's friction just short of the success angle). ``close_steps`` steps close the gripper.
-    Pulling leads the part by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a
-    door about a vertical hinge, and by ``wrist_follow`` of the part's angle about any other hinge (a
-    grasped bar turns between the pads; a hand turned fully with an oven door reaches the Panda's
-    wrist limit). Pulling stops at ``revolute_target`` rad / ``prismatic_target`` m, or when the state
-    grew by less than ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a
-    limit, or a lost grip). The gripper re-grasps (at most ``max_regrasps`` times) if it stays more
-    than ``slip_distance`` m from the part's perceived grasp point for ``slip_steps`` steps (longer
-    than the perception period, so one bad estimate, e.g. of a handle the hand now hides, is not a
-    slip) and its fingers are less than ``hold_gap`` m apart (closed on nothing; a gap means they hold
-    the handle, whatever the perceived grasp point says). After release it backs off
-    ``retreat_distance`` m.
+    ``approach_pitch`` rad for the others (drawers, oven doors, lids: the hand pitches while pulling, so
+    it starts nearer level); a level Panda hand near the table is beyond its wrist limits. The hand first
+    turns in place to the grasp orientation while it is more than ``rotate_first_above`` rad from it, for
+    at most ``rotate_first_steps`` steps (turned while travelling, the arm's IK reaches a low, far handle
+    with the wrist at its joint limit and cannot hold the pose while pulling; 0 steps: never). The fingers
+    approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched fingertip
+    off the surface a handle stands on). Moves are capped at ``max_step_m`` / ``max_step_rad`` per control
+    step; ``pos_tolerance`` / ``rot_tolerance`` end a move, as do ``move_timeout`` steps or
+    ``blocked_steps`` steps without TCP motion (contact). A lid (a revolute part whose grasp point opens
+    within ``lid_max_tilt`` rad of straight up, like a closed laptop) is gripped from above with the
+    fingers ``lid_approach_gap`` m apart and closing along the hinge, across its front lip,
+    ``lid_edge_offset`` m beyond the grasp point away from the hinge (so the pads clear the lid's edge
+    whether the grasp point is the lip's centre, as with ground truth, or the outer band of its points, as
+    from CAPT); the hand turns by ``lid_wrist_follow`` of the lid's angle (the pinch lets the lip turn
+    between the pads; a hand turned with the lid would point back at the robot), and pulls to
+    ``lid_revolute_target`` rad (past upright, so the lid does not rest on its hinge's friction just short
+    of the success angle). ``close_steps`` steps close the gripper. Pulling leads the part by
+    ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a door about a vertical hinge, and
+    by ``wrist_follow`` of the part's angle about any other hinge (a grasped bar turns between the pads; a
+    hand turned fully with an oven door reaches the Panda's wrist limit). Pulling stops at
+    ``revolute_target`` rad / ``prismatic_target`` m, or when the state grew by less than
+    ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost grip).
+    The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than ``slip_distance`` m from
+    the part's perceived grasp point for ``slip_steps`` steps (longer than the perception period, so one
+    bad estimate, e.g. of a handle the hand now hides, is not a slip) and its fingers are less than
+    ``hold_gap`` m apart (closed on nothing; a gap means they hold the handle, whatever the perceived
+    grasp point says). After release it backs off ``retreat_distance`` m.
     """
 
     pregrasp_offset: float = 0.08
@@ -47,6 +49,8 @@ class ScriptedOpenerConfig:
     approach_pitch: float = 0.55
     vertical_hinge_pitch: float = 0.8
     vertical_hinge_max_tilt: float = 0.8
+    rotate_first_above: float = 0.4
+    rotate_first_steps: int = 25
     max_step_m: float = 0.03
     max_step_rad: float = 0.15
     pos_tolerance: float = 0.012
@@ -81,6 +85,10 @@ class ScriptedOpenerConfig:
                     "revolute_target", "prismatic_target", "lid_revolute_target",
                     "slip_distance", "hold_gap"):
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
+        require(self.rotate_first_above > 0,
+                f"rotate_first_above must be > 0 rad, got {self.rotate_first_above}")
+        require(self.rotate_first_steps >= 0,
+                f"rotate_first_steps must be >= 0 (0: never), got {self.rotate_first_steps}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",
                     "slip_steps"):
             require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")

@@ -9,7 +9,9 @@ estimate cannot produce large motions, and the same actions work with CPU and GP
 
 Strategy, per episode:
 
-1. ``PREGRASP``: open the gripper to ``approach_gap`` and move to ``pregrasp_offset`` outside the
+1. ``PREGRASP``: open the gripper to ``approach_gap``, turn the hand in place to the grasp
+   orientation (while it is more than ``rotate_first_above`` rad away, for at most
+   ``rotate_first_steps`` steps), and move to ``pregrasp_offset`` outside the
    grasp point along the part's outward normal ``n`` (revolute: the opening direction of the grasp point,
    ``axis x (grasp - pivot)``; prismatic: the axis), with the TCP approach axis along ``-n`` and the
    fingers closing perpendicular to the handle (revolute: along the radius from the axis, so a bar
@@ -238,6 +240,12 @@ class ScriptedOpener:
                 goal = point + approach * cfg.grasp_depth
             gap = cfg.lid_approach_gap if self._lid else cfg.approach_gap
             action, perr, rerr = self._goto(p, r, goal, self._target_r, gripper_action(gap))
+            if (self.phase == Phase.PREGRASP and rerr > cfg.rotate_first_above
+                    and self.phase_steps <= cfg.rotate_first_steps):
+                # turn the hand where it is first: turned while travelling, the IK ends low and far
+                # with the wrist at its limit (drawers), from where it cannot hold the grasp pose
+                action[:3] = 0.0
+                return action
             if self._reached(p, perr, rerr):
                 self._set(Phase.APPROACH if self.phase == Phase.PREGRASP else Phase.CLOSE)
             return action

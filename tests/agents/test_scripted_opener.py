@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
@@ -65,11 +66,31 @@ def test_swept_angle_is_signed_and_ignores_travel_along_the_axis() -> None:
 def test_bad_opener_config_is_rejected() -> None:
     with pytest.raises(ConfigError, match="close_steps"):
         from_dict(ScriptedOpenerConfig, {"close_steps": 0})
+    with pytest.raises(ConfigError, match="rotate_first_above"):
+        from_dict(ScriptedOpenerConfig, {"rotate_first_above": 0.0})
+
+
+def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
+    drawer = JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.zeros(3), 0.0,
+                               np.array([0.1, 0.0, 0.09]))
+    cfg = ScriptedOpenerConfig()
+    down = np.array([0.0, 0.0, 0.3, 0.0, 1.0, 0.0, 0.0])  # TCP above, pointing down (wxyz)
+    opener = ScriptedOpener(cfg)
+    action = opener.act_on(drawer, down)
+    assert np.all(action[:3] == 0.0) and np.abs(action[3:6]).max() > 0.5
+    # once turned, it travels: the hand already at the grasp orientation moves towards the pregrasp
+    turned = Rotation.from_matrix(opener._target_r).as_quat(scalar_first=True)
+    action = opener.act_on(drawer, np.concatenate([down[:3], turned]))
+    assert np.abs(action[:3]).max() > 0.1 and np.abs(action[3:6]).max() < 0.05
+    # and not for ever: after rotate_first_steps steps it travels and turns together
+    opener = ScriptedOpener(ScriptedOpenerConfig(rotate_first_steps=0))
+    assert np.abs(opener.act_on(drawer, down)[:3]).max() > 0.1
 
 
 @pytest.mark.parametrize(("category", "seed", "max_steps"), [
     ("washing_machine", 0, 150),  # a round door on a vertical hinge
     ("laptop", 3, 200),           # a lid: gripped from above across its lip
+    ("drawer_cabinet", 0, 200),   # a low handle at the arm's reach (open 0.44 before turn-first)
 ])
 def test_opens_with_oracle_perception(category: str, seed: int, max_steps: int) -> None:
     env = make_env(category, {"source": "oracle"})
