@@ -41,7 +41,11 @@ class ScriptedOpenerConfig:
     the part's perceived grasp point for ``slip_steps`` steps (longer than the perception period, so one
     bad estimate, e.g. of a handle the hand now hides, is not a slip) and its fingers are less than
     ``hold_gap`` m apart (closed on nothing; a gap means they hold the handle, whatever the perceived
-    grasp point says). After release it backs off ``retreat_distance`` m.
+    grasp point says). Pulling a prismatic part ends for good, without a re-grasp, when the hand, having
+    pulled at a cruising speed of at least ``limit_min_speed_m`` m per step, moves less than
+    ``limit_slowdown`` of that speed for ``limit_window`` steps: the part has hit its end stop (pulled on,
+    the handle would slide out of the fingers and a re-grasp would chase an open drawer). After release it
+    backs off ``retreat_distance`` m.
     """
 
     pregrasp_offset: float = 0.08
@@ -75,6 +79,9 @@ class ScriptedOpenerConfig:
     slip_distance: float = 0.07
     slip_steps: int = 8
     hold_gap: float = 0.004
+    limit_slowdown: float = 0.6
+    limit_window: int = 2
+    limit_min_speed_m: float = 0.005
     max_regrasps: int = 2
     retreat_distance: float = 0.08
     release_steps: int = 6
@@ -83,14 +90,14 @@ class ScriptedOpenerConfig:
         for key in ("pregrasp_offset", "max_step_m", "max_step_rad", "pos_tolerance", "rot_tolerance",
                     "revolute_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
                     "revolute_target", "prismatic_target", "lid_revolute_target",
-                    "slip_distance", "hold_gap"):
+                    "slip_distance", "hold_gap", "limit_min_speed_m"):
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         require(self.rotate_first_above > 0,
                 f"rotate_first_above must be > 0 rad, got {self.rotate_first_above}")
         require(self.rotate_first_steps >= 0,
                 f"rotate_first_steps must be >= 0 (0: never), got {self.rotate_first_steps}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",
-                    "slip_steps"):
+                    "slip_steps", "limit_window"):
             require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")
         require(0.0 < self.approach_gap <= 0.08,
                 f"approach_gap must be in (0, 0.08] m, got {self.approach_gap}")
@@ -100,6 +107,8 @@ class ScriptedOpenerConfig:
         require(0.0 < self.lid_approach_gap <= 0.08,
                 f"lid_approach_gap must be in (0, 0.08] m, got {self.lid_approach_gap}")
         require(self.lid_edge_offset >= 0, f"lid_edge_offset must be >= 0 m, got {self.lid_edge_offset}")
+        require(0.0 < self.limit_slowdown < 1.0,
+                f"limit_slowdown must be in (0, 1), got {self.limit_slowdown}")
         require(self.max_regrasps >= 0, "max_regrasps must be >= 0")
         for key in ("approach_pitch", "vertical_hinge_pitch", "vertical_hinge_max_tilt", "lid_max_tilt"):
             value = getattr(self, key)

@@ -32,7 +32,9 @@ Strategy, per episode:
 If the TCP stays away from the part's grasp point for ``slip_steps`` while pulling and the fingers
 have closed on nothing (their gap, from the Panda's qpos, below ``hold_gap``), it goes back to 1;
 if pulling stalls short of the target (a slipping grip, or the arm's range), it releases, retreats
-and goes back to 1 from the part's new pose (re-grasps are bounded by ``max_regrasps``).
+and goes back to 1 from the part's new pose (re-grasps are bounded by ``max_regrasps``). A prismatic
+part that brakes the pulling hand (see ``limit_slowdown``) has reached its end stop: the hand
+releases, retreats and is done.
 """
 
 from __future__ import annotations
@@ -288,6 +290,18 @@ class ScriptedOpener:
         action[6] = GRIPPER_OPEN
         return action
 
+    def _braked(self) -> bool:
+        """Whether the hand, pulling at a cruising speed (median step of this pull, at least
+        ``limit_min_speed_m`` m), moved less than ``limit_slowdown`` of it in each of the last
+        ``limit_window`` steps under the same command: something stopped the part."""
+        cfg = self.cfg
+        steps = np.diff(self._history)
+        if len(steps) < cfg.limit_window + 5:
+            return False
+        cruise = float(np.median(steps[:-cfg.limit_window]))
+        recent = steps[-cfg.limit_window:]
+        return cruise >= cfg.limit_min_speed_m and bool(np.all(recent < cfg.limit_slowdown * cruise))
+
     def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
               finger_gap: float | None = None) -> np.ndarray:
         cfg = self.cfg
@@ -301,6 +315,9 @@ class ScriptedOpener:
         else:
             state = self._grasp_state + float((p - self._grasp_p) @ u)
         self._history.append(state)
+        # a drawer runs freely up to its end stop, where the hand brakes before the handle slides out
+        # of the fingers: that is the limit, and grasping again would chase a part that is open
+        at_limit = not revolute and self._braked()
         if revolute:
             target = cfg.lid_revolute_target if self._lid else cfg.revolute_target
         else:
@@ -308,9 +325,9 @@ class ScriptedOpener:
         min_progress = cfg.stall_progress if revolute else cfg.stall_progress_m
         stalled = (len(self._history) > cfg.stall_steps
                    and self._history[-1] - self._history[-1 - cfg.stall_steps] < min_progress)
-        if state >= target or stalled:
+        if state >= target or stalled or at_limit:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
-            self._grasp_again = state < target and self.regrasps < cfg.max_regrasps
+            self._grasp_again = state < target and not at_limit and self.regrasps < cfg.max_regrasps
             self.regrasps += int(self._grasp_again)
             self._set(Phase.RELEASE)
             action = np.zeros(7, np.float32)

@@ -102,6 +102,20 @@ def test_opens_with_oracle_perception(category: str, seed: int, max_steps: int) 
     assert result.open_fraction >= 0.75
 
 
+def test_a_drawer_at_its_end_stop_is_released_not_grasped_again() -> None:
+    """Drawer seed 4 runs to its end stop in the first pull; the braking hand ends the pull there
+    (before, the handle slid out of the fingers and the opener grasped again twice)."""
+    env = make_env("drawer_cabinet", {"source": "oracle"})
+    opener = ScriptedOpener()
+    try:
+        result = run_episode(env, opener, seed=4, max_steps=200)
+    finally:
+        env.close()
+    assert result.success and result.phase == "done", result
+    assert opener.regrasps == 0
+    assert result.steps < 150
+
+
 @pytest.mark.slow
 def test_opens_a_drawer_with_noisy_oracle_perception() -> None:
     env = make_env("drawer_cabinet", {"source": "noisy_oracle"})
