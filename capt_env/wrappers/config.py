@@ -77,6 +77,11 @@ class PerceptionWrapperConfig:
     revolute estimate's line on the edge of the flat moving part away from the grasp point, in the
     part's plane, when CAPT's own line is more than 6 cm off that edge, and turn the direction into
     the part's plane (``moving_part_geometry.hinge_on_edge``); off, the line is CAPT's own.
+    ``order_stacked_parts`` (``capt`` only): when the model has several prismatic joints (a stack of
+    drawers, numbered from the bottom as in the dataset), the target drawer's grasp point is the
+    target-index-th handle from the bottom on the stack's front (``stacked_parts``), not the handle
+    of the part CAPT labels with the target's index (it often gives a drawer its neighbour's label);
+    with fewer handles in view, CAPT's label decides.
     """
 
     source: Source = "oracle"
@@ -88,6 +93,7 @@ class PerceptionWrapperConfig:
     obs_format: ObsFormat = "flat"
     seed: int = 0
     hinge_on_part_edge: bool = True
+    order_stacked_parts: bool = True
 
     def validate(self) -> None:
         require(self.every_k_steps >= 1, f"every_k_steps must be >= 1, got {self.every_k_steps}")

@@ -21,12 +21,14 @@ from capt_env.wrappers.estimate import (
 )
 from capt_env.wrappers.estimate_fusion import EstimateFusion
 from capt_env.wrappers.moving_part_geometry import (
+    PartPlane,
     edge_aligned_direction,
     handle_point,
     hinge_on_edge,
     opening_direction,
     part_plane,
 )
+from capt_env.wrappers.stacked_parts import kth_handle_from_bottom
 
 
 class PerceptionSource(Protocol):
@@ -37,6 +39,14 @@ class PerceptionSource(Protocol):
     def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
         """Estimate from object points (M, 3) world frame metres (or None) and the env's info."""
         ...
+
+
+def faces_along(plane: PartPlane | None, direction: np.ndarray, max_angle: float = 0.6) -> bool:
+    """Whether ``plane``'s normal is within ``max_angle`` rad of the line of ``direction`` (3,): a
+    drawer's front faces along its slide. False for no plane."""
+    if plane is None:
+        return False
+    return abs(float(plane.outward @ unit(direction))) >= float(np.cos(max_angle))
 
 
 def _target(info: dict[str, Any]) -> int:
@@ -101,7 +111,10 @@ class CaptSource:
     The checkpoint is loaded on the first call. The target joint's channel is the env's target joint
     index; the grasp point is the handle standing off the plane of the points CAPT labels as that
     joint's moving part (``handle_point``), else the far edge of those points (all points if it
-    labels none). The axis sign is set so that opening moves the part away from its body
+    labels none). With ``order_stacked_parts`` and a model of several prismatic joints (a drawer
+    stack, numbered from the bottom), the grasp point is instead the target-index-th handle from
+    the bottom on the stack's front when that many are in view (``stacked_parts``).
+    The axis sign is set so that opening moves the part away from its body
     (``opening_direction``): CAPT often gets a hinge's sign wrong while the line is right.
     Successive estimates within an episode are fused (see ``estimate_fusion``);
     :meth:`reset` starts a new episode.
@@ -109,10 +122,12 @@ class CaptSource:
 
     needs_points = True
 
-    def __init__(self, checkpoint: str, seed: int = 0, hinge_on_part_edge: bool = False) -> None:
+    def __init__(self, checkpoint: str, seed: int = 0, hinge_on_part_edge: bool = False,
+                 order_stacked_parts: bool = False) -> None:
         self.checkpoint = checkpoint
         self.seed = seed
         self.hinge_on_part_edge = hinge_on_part_edge
+        self.order_stacked_parts = order_stacked_parts
         self._estimator: Any = None
         self._fusion = EstimateFusion()
 
@@ -126,6 +141,23 @@ class CaptSource:
 
             self._estimator = ArticulationEstimator.from_checkpoint(self.checkpoint, seed=self.seed)
         return self._estimator
+
+    @staticmethod
+    def _stacked_handle(points: np.ndarray, result: Any, model: Any, k: int,
+                        direction: np.ndarray) -> tuple[PartPlane | None, np.ndarray | None]:
+        """(front plane, k-th handle from the bottom) of a stack of prismatic parts, or (None, None)
+        when the model has fewer than two prismatic joints, the front is not flat or does not face
+        along the slide ``direction``, or fewer than k + 1 handles are in view."""
+        stacked = [int(c) for c, t in zip(model.joint_child_parts, model.joint_types, strict=False)
+                   if t == "prismatic"]
+        if len(stacked) < 2:
+            return None, None
+        front = points[np.isin(np.asarray(result.part_labels), stacked)]
+        plane = part_plane(points, front)
+        if not faces_along(plane, direction):
+            return None, None
+        handle = kth_handle_from_bottom(points, front, k, plane=plane)
+        return (plane, handle) if handle is not None else (None, None)
 
     def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
         if points is None:
@@ -141,10 +173,21 @@ class CaptSource:
             if mask.sum() >= 3:
                 moving = points[mask]
         direction = unit(joint.direction)
-        plane = part_plane(points, moving)
+        plane, grasp = None, None
+        if self.order_stacked_parts and joint.type == "prismatic" and child_parts is not None:
+            plane, grasp = self._stacked_handle(points, result, est.config.model, k, direction)
+        if grasp is None:
+            plane = part_plane(points, moving)
+            if joint.type == "prismatic" and not faces_along(plane, direction):
+                plane = None  # an open drawer's largest plane is its bottom or a side, not its front
         if plane is not None and self.hinge_on_part_edge and joint.type == "revolute":
             direction = edge_aligned_direction(direction, plane, moving)
-        grasp = None if plane is None else handle_point(points, moving, plane=plane)
+        if grasp is None and plane is not None:
+            grasp = handle_point(points, moving, plane=plane)
+        if plane is not None and joint.type == "prismatic":
+            # the front-most points along a wrongly signed axis would be the part's back
+            direction = opening_direction(joint.type, direction, np.asarray(joint.pivot), direction,
+                                          plane.outward)
         if grasp is None:
             grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
@@ -157,7 +200,7 @@ class CaptSource:
 
 
 def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: int,
-                hinge_on_part_edge: bool = False) -> PerceptionSource:
+                hinge_on_part_edge: bool = False, order_stacked_parts: bool = False) -> PerceptionSource:
     """The source named ``source`` ("oracle", "noisy_oracle", "capt")."""
     if source == "oracle":
         return OracleSource()
@@ -166,5 +209,5 @@ def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: i
     if source == "capt":
         if checkpoint is None:
             raise ValueError("source 'capt' needs a checkpoint path")
-        return CaptSource(checkpoint, seed, hinge_on_part_edge)
+        return CaptSource(checkpoint, seed, hinge_on_part_edge, order_stacked_parts)
     raise ValueError(f"unknown perception source {source!r}")

@@ -50,7 +50,7 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         cfg.validate()
         self.config = cfg
         self.source: PerceptionSource = make_source(cfg.source, cfg.noise, cfg.checkpoint, cfg.seed,
-                                                     cfg.hinge_on_part_edge)
+                                                     cfg.hinge_on_part_edge, cfg.order_stacked_parts)
         obs_mode = getattr(env.unwrapped, "obs_mode", None)
         if self.source.needs_points and obs_mode != "pointcloud":
             raise ValueError(

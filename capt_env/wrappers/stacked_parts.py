@@ -1,0 +1,71 @@
+"""Which of several stacked parts (a cabinet's drawers) is the k-th from the bottom, by their handles.
+
+A drawer cabinet's joints are numbered from the bottom drawer up (``drawer_0`` is the lowest). CAPT
+segments drawers from the body well but often gives a drawer its neighbour's label, so the target
+drawer is found geometrically instead: the handles standing off the drawers' common front plane are
+grouped by height, one group per drawer, and the k-th group from the bottom is the target's handle.
+World frame, metres; the stacking direction is world up.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from capt_env.wrappers.moving_part_geometry import PartPlane, part_plane
+
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+def handle_groups(object_points: np.ndarray, front_points: np.ndarray, plane: PartPlane | None = None,
+                  min_standoff: float = 0.012, max_standoff: float = 0.08, margin: float = 0.05,
+                  min_gap: float = 0.04, min_points: int = 3,
+                  face_band: float = 0.015) -> list[np.ndarray]:
+    """Handles on a stack's front, bottom up: one (M_i, 3) array of ``object_points`` per handle.
+
+    ``front_points`` (K, 3) are points of the stacked parts (CAPT's union of them); the front plane
+    is ``plane`` or fitted to them. The front's extent is that of all ``object_points`` within
+    ``face_band`` m of the plane (so a drawer CAPT missed still counts), grown by ``margin`` m;
+    handle points stand ``min_standoff``..``max_standoff`` m outside the plane, inside that extent.
+    Sorted by height, they are split wherever consecutive heights differ by more than ``min_gap`` m
+    (handles of stacked drawers are a drawer's height apart, >= 0.1 m here); groups of fewer than
+    ``min_points`` points are noise and dropped. Empty when the front is not flat.
+    """
+    plane = plane or part_plane(object_points, front_points)
+    if plane is None:
+        return []
+    standoff = (object_points - plane.centre) @ plane.outward
+    uv = (object_points - plane.centre) @ plane.in_plane.T
+    face = np.abs(standoff) < face_band  # the whole front: every drawer's and the carcass's
+    if int(face.sum()) < min_points:
+        return []
+    lo, hi = uv[face].min(axis=0) - margin, uv[face].max(axis=0) + margin
+    keep = ((standoff > min_standoff) & (standoff < max_standoff)
+            & np.all(uv >= lo, axis=1) & np.all(uv <= hi, axis=1))
+    if int(keep.sum()) < min_points:
+        return []
+    candidates = object_points[keep]
+    height = candidates @ _UP
+    order = np.argsort(height)
+    splits = np.flatnonzero(np.diff(height[order]) > min_gap) + 1
+    groups = [candidates[idx] for idx in np.split(order, splits)]
+    return [g for g in groups if len(g) >= min_points]
+
+
+def kth_handle_from_bottom(object_points: np.ndarray, front_points: np.ndarray, k: int,
+                           plane: PartPlane | None = None) -> np.ndarray | None:
+    """Centre (3,) of the ``k``-th handle from the bottom on a stack's front (see
+    :func:`handle_groups`), world frame, metres; None when fewer than ``k + 1`` handles are seen.
+    The centre is the middle of the handle's extent along its main direction (a bar's visible
+    points are denser at one end)."""
+    if k < 0:
+        raise ValueError(f"k must be >= 0, got {k}")
+    groups = handle_groups(object_points, front_points, plane=plane)
+    if len(groups) <= k:
+        return None
+    handle = groups[k]
+    centre = handle.mean(axis=0)
+    if len(handle) < 2:
+        return centre
+    along = np.linalg.svd(handle - centre, full_matrices=False)[2][0]
+    t = np.quantile((handle - centre) @ along, [0.05, 0.95])
+    return centre + along * float(t.mean())

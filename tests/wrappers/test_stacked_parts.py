@@ -1,0 +1,51 @@
+"""The k-th drawer from the bottom is found by its handle on a synthetic cabinet front."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from capt_env.wrappers.stacked_parts import handle_groups, kth_handle_from_bottom
+
+# a cabinet facing the robot (-x): front plane x = 0, drawers 0.12 m tall from z = 0.03, bars 3 cm out
+HANDLE_Z = (0.09, 0.21, 0.33)
+
+
+def _cabinet(rng: np.random.Generator,
+             handles: tuple[float, ...] = HANDLE_Z) -> tuple[np.ndarray, np.ndarray]:
+    """(all points, drawer-front points): a 0.4 x 0.36 m front at x = 0 with a carcass behind it,
+    and one horizontal bar per height in ``handles`` standing 3 cm in front."""
+    front = np.column_stack([rng.normal(0.0, 0.002, 900), rng.uniform(-0.2, 0.2, 900),
+                             rng.uniform(0.03, 0.39, 900)])
+    body = np.column_stack([rng.uniform(0.0, 0.4, 600), rng.choice([-0.2, 0.2], 600),
+                            rng.uniform(0.03, 0.39, 600)])
+    bars = [np.column_stack([rng.normal(-0.03, 0.002, 40), rng.uniform(-0.06, 0.06, 40),
+                             rng.normal(z, 0.003, 40)]) for z in handles]
+    return np.concatenate([front, body, *bars]), front
+
+
+def test_handles_are_grouped_bottom_up_and_the_kth_is_picked() -> None:
+    cloud, front = _cabinet(np.random.default_rng(0))
+    groups = handle_groups(cloud, front)
+    assert [round(float(g[:, 2].mean()), 2) for g in groups] == list(HANDLE_Z)
+    for k, z in enumerate(HANDLE_Z):
+        h = kth_handle_from_bottom(cloud, front, k)
+        assert h is not None
+        np.testing.assert_allclose(h, [-0.03, 0.0, z], atol=0.01)
+
+
+def test_a_drawer_front_the_segmentation_missed_still_counts() -> None:
+    cloud, front = _cabinet(np.random.default_rng(1))
+    top_only = front[front[:, 2] > 0.27]  # CAPT labelled only the top drawer
+    h = kth_handle_from_bottom(cloud, top_only, 0)
+    assert h is not None and h[2] == pytest.approx(0.09, abs=0.01)
+
+
+def test_too_few_handles_in_view_gives_none() -> None:
+    cloud, front = _cabinet(np.random.default_rng(2), handles=(0.21,))
+    assert kth_handle_from_bottom(cloud, front, 0) is not None
+    assert kth_handle_from_bottom(cloud, front, 1) is None
+    with pytest.raises(ValueError, match="k must be"):
+        kth_handle_from_bottom(cloud, front, -1)
+    blob = np.random.default_rng(3).normal(size=(200, 3)) * 0.1  # not flat: no front
+    assert handle_groups(blob, blob) == []
