@@ -49,3 +49,15 @@ def test_too_few_handles_in_view_gives_none() -> None:
         kth_handle_from_bottom(cloud, front, -1)
     blob = np.random.default_rng(3).normal(size=(200, 3)) * 0.1  # not flat: no front
     assert handle_groups(blob, blob) == []
+
+
+def test_a_drawer_front_faces_along_the_slide_its_bottom_does_not() -> None:
+    from capt_env.wrappers.moving_part_geometry import PartPlane
+    from capt_env.wrappers.perception_sources import faces_along
+
+    slide = np.array([-1.0, 0.05, 0.0])
+    front = PartPlane(np.zeros(3), np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), np.array([-1.0, 0.0, 0.0]))
+    bottom = PartPlane(np.zeros(3), np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), np.array([0.0, 0.0, -1.0]))
+    assert faces_along(front, slide) and faces_along(front, -slide)  # the line, either sign
+    assert not faces_along(bottom, slide)
+    assert not faces_along(None, slide)
