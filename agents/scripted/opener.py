@@ -28,7 +28,8 @@ Strategy, per episode:
    ``wrist_follow`` of the angle about other hinges. The estimate is re-read every step, so
    re-estimation corrects the path.
 5. ``RELEASE`` when that state reaches the target (or stops growing: a limit), open, and
-   ``RETREAT`` along the outward normal; then ``DONE`` (hold still, gripper open).
+   ``RETREAT`` back along the approach axis (until there, blocked or timed out); then ``DONE``
+   (hold still, gripper open).
 If the TCP stays away from the part's grasp point for ``slip_steps`` while pulling and the fingers
 have closed on nothing (their gap, from the Panda's qpos, below ``hold_gap``), it goes back to 1;
 if pulling stalls short of the target (a slipping grip, or the arm's range), it releases, retreats
@@ -277,7 +278,7 @@ class ScriptedOpener:
             assert self._retreat_from is not None
             goal = self._retreat_from - r[:, 2] * cfg.retreat_distance
             action, perr, _ = self._goto(p, r, goal, r, GRIPPER_OPEN)
-            if perr < cfg.pos_tolerance or self.phase_steps >= cfg.move_timeout:
+            if self._reached(p, perr, 0.0):  # there, timed out, or blocked (the arm's range)
                 if self._grasp_again:
                     self._grasp_again = False
                     self._target_r = None
