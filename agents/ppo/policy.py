@@ -60,7 +60,8 @@ class PPOPolicy:
         self.model = model
         self.obs_norm = obs_norm
         self.residual = residual
-        self._pinned: np.ndarray | None = None
+        self._pinned = np.zeros(0, dtype=np.int64)  # indices of features fixed at training values
+        self._pinned_values = np.zeros(0, dtype=np.float32)
         if obs_norm is not None:
             obs_norm.training = False
             rms = obs_norm.obs_rms
@@ -117,7 +118,7 @@ class PPOPolicy:
         if self.residual is not None:
             x = self.residual.observe(x, info)
         if self.obs_norm is not None:
-            if self._pinned is not None and self._pinned.size:
+            if self._pinned.size:
                 x = x.copy()
                 x[..., self._pinned] = self._pinned_values
             x = self.obs_norm.normalize_obs(x).astype(np.float32)

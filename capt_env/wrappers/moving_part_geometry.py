@@ -64,21 +64,35 @@ def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standof
     plane = plane or part_plane(object_points, part_points)
     if plane is None or len(object_points) < min_points:
         return None
-    standoff = (object_points - plane.centre) @ plane.outward
     in_plane = (part_points - plane.centre) @ plane.in_plane.T
-    lo, hi = in_plane.min(axis=0) - margin, in_plane.max(axis=0) + margin
-    uv = (object_points - plane.centre) @ plane.in_plane.T
-    keep = ((standoff > min_standoff) & (standoff < max_standoff)
-            & np.all(uv >= lo, axis=1) & np.all(uv <= hi, axis=1))
+    keep = standing_off(object_points, plane, in_plane.min(axis=0) - margin,
+                        in_plane.max(axis=0) + margin, min_standoff, max_standoff)
     if int(keep.sum()) < min_points:
         return None
     # the handle is what stands out furthest; surface bumps and noise sit just above min_standoff
+    standoff = (object_points - plane.centre) @ plane.outward
     keep &= standoff >= 0.5 * float(np.quantile(standoff[keep], 0.9))
     if int(keep.sum()) < min_points:
         return None
-    handle = object_points[keep]
+    return bar_centre(object_points[keep])
+
+
+def standing_off(points: np.ndarray, plane: PartPlane, lo: np.ndarray, hi: np.ndarray,
+                 min_standoff: float, max_standoff: float) -> np.ndarray:
+    """(N,) mask of ``points`` (N, 3) between ``min_standoff`` and ``max_standoff`` m outside
+    ``plane`` whose in-plane coordinates (along ``plane.in_plane``) lie within ``lo``..``hi`` (2,)."""
+    standoff = (points - plane.centre) @ plane.outward
+    uv = (points - plane.centre) @ plane.in_plane.T
+    return ((standoff > min_standoff) & (standoff < max_standoff)
+            & np.all(uv >= lo, axis=1) & np.all(uv <= hi, axis=1))
+
+
+def bar_centre(handle: np.ndarray) -> np.ndarray:
+    """Centre (3,) of a handle's points (M, 3): their centroid moved, along their main direction, to
+    the middle of their extent (the visible points of a bar are denser at one end)."""
     centre = handle.mean(axis=0)
-    # along the bar, the middle of its visible extent: the points' density varies with the view
+    if len(handle) < 2:
+        return centre
     along = np.linalg.svd(handle - centre, full_matrices=False)[2][0]
     t = np.quantile((handle - centre) @ along, [0.05, 0.95])
     return centre + along * float(t.mean())

@@ -185,15 +185,16 @@ class CaptSource:
         if grasp is None and plane is not None:
             grasp = handle_point(points, moving, plane=plane)
         if plane is not None and joint.type == "prismatic":
-            # the front-most points along a wrongly signed axis would be the part's back
-            direction = opening_direction(joint.type, direction, np.asarray(joint.pivot), direction,
-                                          plane.outward)
+            # before the grasp point: the front-most points along a wrongly signed slide are the back
+            # (a prismatic opening direction does not depend on the pivot or grasp point)
+            pivot_in = np.asarray(joint.pivot, dtype=np.float64)
+            direction = opening_direction(joint.type, direction, pivot_in, pivot_in, plane.outward)
         if grasp is None:
             grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
         if plane is not None and self.hinge_on_part_edge and joint.type == "revolute":
             direction, pivot = hinge_on_edge(direction, grasp, plane, moving, pivot=pivot)
-        if plane is not None:
+        if plane is not None and joint.type == "revolute":
             direction = opening_direction(joint.type, direction, pivot, grasp, plane.outward)
         return self._fusion.update(JointAxisEstimate(joint.type, direction, pivot, float(joint.state),
                                                      grasp, float(joint.confidence)))

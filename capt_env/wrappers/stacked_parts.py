@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from capt_env.wrappers.moving_part_geometry import PartPlane, part_plane
+from capt_env.wrappers.moving_part_geometry import PartPlane, bar_centre, part_plane, standing_off
 
 _UP = np.array([0.0, 0.0, 1.0])
 
@@ -34,13 +34,12 @@ def handle_groups(object_points: np.ndarray, front_points: np.ndarray, plane: Pa
     if plane is None:
         return []
     standoff = (object_points - plane.centre) @ plane.outward
-    uv = (object_points - plane.centre) @ plane.in_plane.T
     face = np.abs(standoff) < face_band  # the whole front: every drawer's and the carcass's
     if int(face.sum()) < min_points:
         return []
-    lo, hi = uv[face].min(axis=0) - margin, uv[face].max(axis=0) + margin
-    keep = ((standoff > min_standoff) & (standoff < max_standoff)
-            & np.all(uv >= lo, axis=1) & np.all(uv <= hi, axis=1))
+    uv = (object_points[face] - plane.centre) @ plane.in_plane.T
+    keep = standing_off(object_points, plane, uv.min(axis=0) - margin, uv.max(axis=0) + margin,
+                        min_standoff, max_standoff)
     if int(keep.sum()) < min_points:
         return []
     candidates = object_points[keep]
@@ -62,10 +61,4 @@ def kth_handle_from_bottom(object_points: np.ndarray, front_points: np.ndarray, 
     groups = handle_groups(object_points, front_points, plane=plane)
     if len(groups) <= k:
         return None
-    handle = groups[k]
-    centre = handle.mean(axis=0)
-    if len(handle) < 2:
-        return centre
-    along = np.linalg.svd(handle - centre, full_matrices=False)[2][0]
-    t = np.quantile((handle - centre) @ along, [0.05, 0.95])
-    return centre + along * float(t.mean())
+    return bar_centre(groups[k])
