@@ -31,10 +31,14 @@ class ScriptedOpenerConfig:
     from CAPT); the hand turns by ``lid_wrist_follow`` of the lid's angle (the pinch lets the lip turn
     between the pads; a hand turned with the lid would point back at the robot), and pulls to
     ``lid_revolute_target`` rad (past upright, so the lid does not rest on its hinge's friction just short
-    of the success angle). ``close_steps`` steps close the gripper. Pulling leads the part by
-    ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a door about a vertical hinge, and
-    by ``wrist_follow`` of the part's angle about any other hinge (a grasped bar turns between the pads; a
-    hand turned fully with an oven door reaches the Panda's wrist limit). Pulling stops at
+    of the success angle). If the fingers close on nothing across a lid's lip (it is wider than the open
+    fingers), the hand backs off and lifts the lid from below (``lid_lift``): fingers closed, pointing at
+    the hinge ``lid_lift_pitch`` rad below horizontal, the fingertips go ``lid_lift_below`` m under the
+    grasp point, from ``lid_lift_front`` m in front of it to ``lid_lift_under`` m behind it, and push the
+    lid open along the same arc as a pull. ``close_steps`` steps close the gripper. Pulling leads the part
+    by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a door about a vertical hinge,
+    and by ``wrist_follow`` of the part's angle about any other hinge (a grasped bar turns between the
+    pads; a hand turned fully with an oven door reaches the Panda's wrist limit). Pulling stops at
     ``revolute_target`` rad / ``prismatic_target`` m, or when the state grew by less than
     ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost grip).
     The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than ``slip_distance`` m from
@@ -67,6 +71,12 @@ class ScriptedOpenerConfig:
     lid_edge_offset: float = 0.005
     lid_wrist_follow: float = 0.0
     lid_revolute_target: float = 2.0
+    lid_lift: bool = True
+    lid_lift_pitch: float = 1.3
+    lid_lift_below: float = 0.010
+    lid_lift_front: float = 0.06
+    lid_lift_under: float = 0.0
+    lid_lift_wrist_follow: float = 0.0
     close_steps: int = 8
     revolute_lead: float = 0.12
     prismatic_lead: float = 0.03
@@ -101,12 +111,16 @@ class ScriptedOpenerConfig:
             require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")
         require(0.0 < self.approach_gap <= 0.08,
                 f"approach_gap must be in (0, 0.08] m, got {self.approach_gap}")
-        for key in ("wrist_follow", "lid_wrist_follow"):
+        for key in ("wrist_follow", "lid_wrist_follow", "lid_lift_wrist_follow"):
             value = getattr(self, key)
             require(0.0 <= value <= 1.0, f"{key} must be in [0, 1], got {value}")
         require(0.0 < self.lid_approach_gap <= 0.08,
                 f"lid_approach_gap must be in (0, 0.08] m, got {self.lid_approach_gap}")
         require(self.lid_edge_offset >= 0, f"lid_edge_offset must be >= 0 m, got {self.lid_edge_offset}")
+        require(0.0 < self.lid_lift_pitch <= 1.5,
+                f"lid_lift_pitch must be in (0, 1.5] rad, got {self.lid_lift_pitch}")
+        for key in ("lid_lift_below", "lid_lift_front", "lid_lift_under"):
+            require(getattr(self, key) >= 0, f"{key} must be >= 0 m, got {getattr(self, key)}")
         require(0.0 < self.limit_slowdown < 1.0,
                 f"limit_slowdown must be in (0, 1), got {self.limit_slowdown}")
         require(self.max_regrasps >= 0, "max_regrasps must be >= 0")

@@ -19,7 +19,10 @@ Strategy, per episode:
    horizontal by at least ``vertical_hinge_pitch`` (doors) or ``approach_pitch`` (other parts), as
    the Panda's wrist cannot point level near the table. A lid (its grasp point opens upwards) is
    gripped from above, the fingers closing along the hinge across its front lip (``is_lid``).
-2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper.
+2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper. If a
+   lid's fingers closed on nothing (its lip is wider than the open fingers), the hand backs off and
+   lifts the lid from below instead (:func:`lift_pose`): fingers closed, pointing at the hinge and
+   steeply down, the fingertips slide in under the grasp point, then push along the arc as in 4.
 4. ``PULL``: the part's state is measured by the hand itself while it holds the part (the grasp-time
    estimate plus the TCP's swept angle about the estimated axis, or its travel along it), every
    step and free of the perceived state's noise. The target TCP position is the grasp position moved
@@ -118,6 +121,31 @@ def grasp_target(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> np.ndarra
     return est.grasp_point if radial is None else est.grasp_point + cfg.lid_edge_offset * radial
 
 
+def lid_frame(est: JointAxisEstimate) -> tuple[np.ndarray, np.ndarray] | None:
+    """World unit directions (front, up) at a lid's grasp point: ``front`` along the radius from the
+    hinge out through the grasp point, ``up`` the direction the grasp point opens in
+    (:func:`outward_normal`). None when the grasp point lies on the hinge line."""
+    front = perpendicular(unit(est.direction), est.grasp_point - est.pivot)
+    return None if front is None else (front, outward_normal(est))
+
+
+def lift_pose(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig,
+              phase: Phase) -> tuple[np.ndarray, np.ndarray] | None:
+    """TCP goal (position (3,) m, rotation (3, 3)), world frame, for lifting a lid from below: the
+    closed fingertips, pointing at the hinge and ``lid_lift_pitch`` rad down, go
+    ``lid_lift_below`` m under the grasp point, from ``lid_lift_front`` m in front of it (``PREGRASP``)
+    to ``lid_lift_under`` m behind it (``APPROACH``). For a lip wider than the open fingers."""
+    frame = lid_frame(est)
+    if frame is None:
+        return None
+    front, up = frame
+    approach = -np.cos(cfg.lid_lift_pitch) * front - np.sin(cfg.lid_lift_pitch) * up
+    # front, up and the hinge are orthonormal; the fingers close along the hinge
+    rot = nearer_finger_order(grasp_frame(approach, unit(est.direction)), current)
+    ahead = cfg.lid_lift_front if phase == Phase.PREGRASP else -cfg.lid_lift_under
+    return est.grasp_point + ahead * front - cfg.lid_lift_below * up, rot
+
+
 def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig) -> np.ndarray:
     """TCP rotation (3, 3) for grasping: approach along -n, fingers closing across the handle.
 
@@ -150,9 +178,15 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
         if (rot @ approach)[2] > approach[2]:
             rot = rot.T
         frame = rot @ frame
-    flipped = frame @ np.diag([-1.0, -1.0, 1.0])  # same approach, fingers swapped
+    return nearer_finger_order(frame, current)
+
+
+def nearer_finger_order(frame: np.ndarray, current: np.ndarray) -> np.ndarray:
+    """Of TCP rotation ``frame`` (3, 3) and the same approach with the fingers swapped, the one
+    nearer the current rotation ``current`` (3, 3)."""
+    flipped = frame @ np.diag([-1.0, -1.0, 1.0])
     if np.linalg.norm(rotation_error(flipped, current)) < np.linalg.norm(rotation_error(frame, current)):
-        frame = flipped
+        return flipped
     return frame
 
 
@@ -178,6 +212,7 @@ class ScriptedOpener:
         self._grasp_state = 0.0
         self._target_r: np.ndarray | None = None
         self._lid = False
+        self._lift = False
         self._history: list[float] = []
         self._slip_count = 0
         self._retreat_from: np.ndarray | None = None
@@ -235,14 +270,19 @@ class ScriptedOpener:
             if self._target_r is None or self.phase == Phase.PREGRASP and self.phase_steps == 1:
                 self._target_r = grasp_rotation(est, r, cfg)
                 self._lid = is_lid(est, cfg)
-            approach = self._target_r[:, 2]
-            point = grasp_target(est, cfg) if self._lid else est.grasp_point
-            if self.phase == Phase.PREGRASP:
-                goal = point - approach * cfg.pregrasp_offset
+            lift = lift_pose(est, r, cfg, self.phase) if self._lift else None
+            if lift is not None:
+                goal, self._target_r = lift
+                gripper = GRIPPER_CLOSE
             else:
-                goal = point + approach * cfg.grasp_depth
-            gap = cfg.lid_approach_gap if self._lid else cfg.approach_gap
-            action, perr, rerr = self._goto(p, r, goal, self._target_r, gripper_action(gap))
+                approach = self._target_r[:, 2]
+                point = grasp_target(est, cfg) if self._lid else est.grasp_point
+                if self.phase == Phase.PREGRASP:
+                    goal = point - approach * cfg.pregrasp_offset
+                else:
+                    goal = point + approach * cfg.grasp_depth
+                gripper = gripper_action(cfg.lid_approach_gap if self._lid else cfg.approach_gap)
+            action, perr, rerr = self._goto(p, r, goal, self._target_r, gripper)
             if (self.phase == Phase.PREGRASP and rerr > cfg.rotate_first_above
                     and self.phase_steps <= cfg.rotate_first_steps):
                 # turn the hand where it is first: turned while travelling, the IK ends low and far
@@ -250,17 +290,26 @@ class ScriptedOpener:
                 action[:3] = 0.0
                 return action
             if self._reached(p, perr, rerr):
-                self._set(Phase.APPROACH if self.phase == Phase.PREGRASP else Phase.CLOSE)
+                if self.phase == Phase.PREGRASP:
+                    self._set(Phase.APPROACH)
+                elif lift is not None:  # the closed fingertips are under the lid: push it open
+                    self._start_pull(p, r, est)
+                else:
+                    self._set(Phase.CLOSE)
             return action
 
         if self.phase == Phase.CLOSE:
             action = np.zeros(7, np.float32)
             action[6] = GRIPPER_CLOSE
             if self.phase_steps >= cfg.close_steps:
-                self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
-                self._history = []
-                self._slip_count = 0
-                self._set(Phase.PULL)
+                if (self._lid and cfg.lid_lift and not self._lift and finger_gap is not None
+                        and finger_gap < cfg.hold_gap):
+                    # the fingers closed on nothing across the lid's lip (wider than the open
+                    # fingers): back off, then lift the lid from below
+                    self._lift = self._grasp_again = True
+                    self._set(Phase.RELEASE)
+                else:
+                    self._start_pull(p, r, est)
             return action
 
         if self.phase == Phase.PULL:
@@ -290,6 +339,12 @@ class ScriptedOpener:
         action = np.zeros(7, np.float32)
         action[6] = GRIPPER_OPEN
         return action
+
+    def _start_pull(self, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate) -> None:
+        self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
+        self._history = []
+        self._slip_count = 0
+        self._set(Phase.PULL)
 
     def _braked(self) -> bool:
         """Whether the hand, pulling at a cruising speed (median step of this pull, at least
@@ -349,8 +404,10 @@ class ScriptedOpener:
             p_des = est.pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - est.pivot)
             if is_vertical_hinge(est, cfg):
                 follow = 1.0
+            elif self._lid:
+                follow = cfg.lid_lift_wrist_follow if self._lift else cfg.lid_wrist_follow
             else:
-                follow = cfg.lid_wrist_follow if self._lid else cfg.wrist_follow
+                follow = cfg.wrist_follow
             r_des = axis_angle_matrix(u, follow * delta) @ self._grasp_r
         else:
             delta = state - self._grasp_state + cfg.prismatic_lead

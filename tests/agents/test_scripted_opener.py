@@ -9,7 +9,7 @@ from scipy.spatial.transform import Rotation
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
 from agents.scripted.geometry import axis_angle_matrix, swept_angle
-from agents.scripted.opener import grasp_rotation, grasp_target, is_lid, outward_normal
+from agents.scripted.opener import Phase, grasp_rotation, grasp_target, is_lid, lift_pose, outward_normal
 from agents.scripted.rollout import make_env, run_episode
 from capt_env.wrappers.estimate import JointAxisEstimate
 from perception.yaml_config import ConfigError, from_dict
@@ -39,6 +39,36 @@ def test_a_closed_lid_is_gripped_from_above_across_its_lip() -> None:
     # the TCP grips lid_edge_offset beyond the grasp point, away from the hinge (towards -x)
     np.testing.assert_allclose(grasp_target(est, cfg), est.grasp_point + [-cfg.lid_edge_offset, 0, 0],
                                atol=1e-9)
+
+
+def test_a_lip_the_fingers_closed_on_nothing_is_lifted_from_below() -> None:
+    cfg = ScriptedOpenerConfig()
+    est = _closed_laptop()
+    opener = ScriptedOpener(cfg)
+    above = np.array([-0.1, 0.05, 0.05, 0.0, 1.0, 0.0, 0.0])  # TCP on the lip, pointing down (wxyz)
+    opener.act_on(est, above)  # the first pre-grasp step sees a lid
+    opener._set(Phase.CLOSE)
+    for _ in range(cfg.close_steps):
+        opener.act_on(est, above, finger_gap=0.0)
+    assert opener.phase == Phase.RELEASE and opener._lift  # backs off, then lifts from below
+    # the lift goals: closed fingertips lid_lift_below under the lip, coming from the front (-x)
+    # towards the hinge (+x), pointing lid_lift_pitch below horizontal, closing along the hinge
+    pre, rot = lift_pose(est, np.eye(3), cfg, Phase.PREGRASP)
+    at, _ = lift_pose(est, np.eye(3), cfg, Phase.APPROACH)
+    np.testing.assert_allclose(pre, est.grasp_point + [-cfg.lid_lift_front, 0.0, -cfg.lid_lift_below],
+                               atol=1e-9)
+    np.testing.assert_allclose(at, est.grasp_point + [cfg.lid_lift_under, 0.0, -cfg.lid_lift_below],
+                               atol=1e-9)
+    pitch = cfg.lid_lift_pitch
+    np.testing.assert_allclose(rot[:, 2], [np.cos(pitch), 0.0, -np.sin(pitch)], atol=1e-9)
+    assert abs(rot[:, 1] @ np.array([0.0, 1.0, 0.0])) == pytest.approx(1.0)
+    # fingers that closed on the lip (a gap) pull as before
+    opener = ScriptedOpener(cfg)
+    opener.act_on(est, above)
+    opener._set(Phase.CLOSE)
+    for _ in range(cfg.close_steps):
+        opener.act_on(est, above, finger_gap=0.01)
+    assert opener.phase == Phase.PULL and not opener._lift
 
 
 def test_doors_and_drawers_are_not_lids() -> None:
@@ -90,6 +120,7 @@ def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
 @pytest.mark.parametrize(("category", "seed", "max_steps"), [
     ("washing_machine", 0, 150),  # a round door on a vertical hinge
     ("laptop", 3, 200),           # a lid: gripped from above across its lip
+    ("laptop", 13, 200),          # a lip wider than the open fingers: lifted from below (failed before)
     ("drawer_cabinet", 0, 200),   # a low handle at the arm's reach (open 0.44 before turn-first)
 ])
 def test_opens_with_oracle_perception(category: str, seed: int, max_steps: int) -> None:
