@@ -35,21 +35,21 @@ class ScriptedOpenerConfig:
     fingers), the hand backs off and lifts the lid from below (``lid_lift``): fingers closed, pointing at
     the hinge ``lid_lift_pitch`` rad below horizontal, the fingertips go ``lid_lift_below`` m under the
     grasp point, from ``lid_lift_front`` m in front of it to ``lid_lift_under`` m behind it, and push the
-    lid open along the same arc as a pull. ``close_steps`` steps close the gripper. Pulling leads the part
-    by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a door about a vertical hinge,
-    and by ``wrist_follow`` of the part's angle about any other hinge (a grasped bar turns between the
-    pads; a hand turned fully with an oven door reaches the Panda's wrist limit). Pulling stops at
-    ``revolute_target`` rad / ``prismatic_target`` m, or when the state grew by less than
-    ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost grip).
-    The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than ``slip_distance`` m from
-    the part's perceived grasp point for ``slip_steps`` steps (longer than the perception period, so one
-    bad estimate, e.g. of a handle the hand now hides, is not a slip) and its fingers are less than
-    ``hold_gap`` m apart (closed on nothing; a gap means they hold the handle, whatever the perceived
-    grasp point says). Pulling a prismatic part ends for good, without a re-grasp, when the hand, having
-    pulled at a cruising speed of at least ``limit_min_speed_m`` m per step, moves less than
-    ``limit_slowdown`` of that speed for ``limit_window`` steps: the part has hit its end stop (pulled on,
-    the handle would slide out of the fingers and a re-grasp would chase an open drawer). After release it
-    backs off ``retreat_distance`` m.
+    lid open along the same arc as a pull, the hand turning by ``lid_lift_wrist_follow`` of the lid's
+    angle. ``close_steps`` steps close the gripper. Pulling leads the part by ``revolute_lead`` rad or
+    ``prismatic_lead`` m. The hand turns with a door about a vertical hinge, and by ``wrist_follow`` of
+    the part's angle about any other hinge (a grasped bar turns between the pads; a hand turned fully with
+    an oven door reaches the Panda's wrist limit). Pulling stops at ``revolute_target`` rad /
+    ``prismatic_target`` m, or when the state grew by less than ``stall_progress`` rad /
+    ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost grip). The gripper re-grasps (at
+    most ``max_regrasps`` times) if it stays more than ``slip_distance`` m from the part's perceived grasp
+    point for ``slip_steps`` steps (longer than the perception period, so one bad estimate, e.g. of a
+    handle the hand now hides, is not a slip) and its fingers are less than ``hold_gap`` m apart (closed
+    on nothing; a gap means they hold the handle, whatever the perceived grasp point says). Pulling a
+    prismatic part ends for good, without a re-grasp, when the hand, having pulled at a cruising speed of
+    at least ``limit_min_speed_m`` m per step, moves less than ``limit_slowdown`` of that speed for
+    ``limit_window`` steps: the part has hit its end stop (pulled on, the handle would slide out of the
+    fingers and a re-grasp would chase an open drawer). After release it backs off ``retreat_distance`` m.
     """
 
     pregrasp_offset: float = 0.08

@@ -98,6 +98,10 @@ def test_bad_opener_config_is_rejected() -> None:
         from_dict(ScriptedOpenerConfig, {"close_steps": 0})
     with pytest.raises(ConfigError, match="rotate_first_above"):
         from_dict(ScriptedOpenerConfig, {"rotate_first_above": 0.0})
+    with pytest.raises(ConfigError, match="lid_lift_pitch"):
+        from_dict(ScriptedOpenerConfig, {"lid_lift_pitch": 2.0})
+    with pytest.raises(ConfigError, match="lid_lift_below"):
+        from_dict(ScriptedOpenerConfig, {"lid_lift_below": -0.01})
 
 
 def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
