@@ -52,15 +52,20 @@ class NoiseConfig:
     """Noise of the ``noisy_oracle`` source: the axis direction is tilted by an angle drawn from
     N(0, ``direction_rad``) (radians) about a random perpendicular axis; pivot and grasp point get
     isotropic Gaussian offsets with per-axis std ``pivot_m`` / ``grasp_m`` (metres); the state gets
-    N(0, ``state``) (radians or metres)."""
+    N(0, ``state``) (radians or metres). ``grasp_outward_m`` is a constant bias, not noise: the
+    grasp point moves that far (metres) along the part's opening direction at it (revolute: along the
+    radius from the axis; prismatic: along the axis), like an estimator whose grasp-point convention
+    differs from the ground truth's (CAPT puts a laptop's at the outer band of its lip's points, about
+    1.2 cm beyond the lip's centre)."""
 
     direction_rad: float = 0.05
     pivot_m: float = 0.01
     state: float = 0.02
     grasp_m: float = 0.005
+    grasp_outward_m: float = 0.0
 
     def validate(self) -> None:
-        for key in ("direction_rad", "pivot_m", "state", "grasp_m"):
+        for key in ("direction_rad", "pivot_m", "state", "grasp_m", "grasp_outward_m"):
             require(getattr(self, key) >= 0, f"noise.{key} must be >= 0, got {getattr(self, key)}")
         require(self.direction_rad <= 3.15, "noise.direction_rad must be <= pi")
 

@@ -13,6 +13,7 @@ from capt_env.wrappers import CaptObservationWrapper, observation_layout
 from capt_env.wrappers.config import NoiseConfig
 from capt_env.wrappers.joint_observation import OBSERVATION_SIZE, decode_observation
 from capt_env.wrappers.perception_sources import NoisyOracleSource, ground_truth_estimate
+from perception.yaml_config import ConfigError, from_dict
 
 TASK = {"split": "test", "object_xy": (0.3, 0.0)}
 
@@ -78,6 +79,22 @@ def test_noisy_oracle_noise_has_the_configured_magnitude() -> None:
     off = np.array([np.linalg.norm(np.cross(e.pivot - gt.pivot, gt.direction)) for e in est])
     assert abs(np.sqrt((off ** 2).mean()) - 0.02 * np.sqrt(2)) < 0.004
     np.testing.assert_allclose([e.grasp_point for e in est], np.tile(gt.grasp_point, (3000, 1)))
+
+
+def test_noisy_oracle_grasp_outward_bias_moves_the_grasp_point_away_from_the_joint() -> None:
+    # hinge along z through (0.1, 0.2): the grasp point (0.4, 0.2, 0.3) lies 0.3 m out along +x
+    info = {"target_joint": 0, "joint_type": np.array([0]), "joint_axis": np.array([[0.0, 0.0, 1.0]]),
+            "joint_pivot": np.array([[0.1, 0.2, 0.0]]), "joint_state": np.array([0.3]),
+            "grasp_point": np.array([0.4, 0.2, 0.3])}
+    quiet = {"direction_rad": 0.0, "pivot_m": 0.0, "state": 0.0, "grasp_m": 0.0}
+    est = NoisyOracleSource(NoiseConfig(**quiet, grasp_outward_m=0.012)).estimate(None, info)
+    np.testing.assert_allclose(est.grasp_point, [0.412, 0.2, 0.3], atol=1e-12)
+    # a prismatic part: along its opening direction
+    info["joint_type"] = np.array([1])
+    est = NoisyOracleSource(NoiseConfig(**quiet, grasp_outward_m=0.012)).estimate(None, info)
+    np.testing.assert_allclose(est.grasp_point, [0.4, 0.2, 0.312], atol=1e-12)
+    with pytest.raises(ConfigError, match="grasp_outward_m"):
+        from_dict(NoiseConfig, {"grasp_outward_m": -0.01})
 
 
 def test_capt_source_needs_a_point_cloud() -> None:
