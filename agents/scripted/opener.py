@@ -111,22 +111,19 @@ def is_lid(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
     return float(outward_normal(est)[2]) >= float(np.cos(cfg.lid_max_tilt))
 
 
-def grasp_target(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> np.ndarray:
-    """World point (3,) the TCP grips: the grasp point, moved ``lid_edge_offset`` m further from the
-    hinge on a lid (the fingers then pinch the front of the lip and clear the lid's edge)."""
-    if not is_lid(est, cfg):
-        return est.grasp_point
-    u = unit(est.direction)
-    radial = perpendicular(u, est.grasp_point - est.pivot)
-    return est.grasp_point if radial is None else est.grasp_point + cfg.lid_edge_offset * radial
-
-
 def lid_frame(est: JointAxisEstimate) -> tuple[np.ndarray, np.ndarray] | None:
     """World unit directions (front, up) at a lid's grasp point: ``front`` along the radius from the
     hinge out through the grasp point, ``up`` the direction the grasp point opens in
     (:func:`outward_normal`). None when the grasp point lies on the hinge line."""
     front = perpendicular(unit(est.direction), est.grasp_point - est.pivot)
     return None if front is None else (front, outward_normal(est))
+
+
+def grasp_target(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> np.ndarray:
+    """World point (3,) the TCP grips: the grasp point, moved ``lid_edge_offset`` m further from the
+    hinge on a lid (the fingers then pinch the front of the lip and clear the lid's edge)."""
+    frame = lid_frame(est) if is_lid(est, cfg) else None
+    return est.grasp_point if frame is None else est.grasp_point + cfg.lid_edge_offset * frame[0]
 
 
 def lift_pose(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig,

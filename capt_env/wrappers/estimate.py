@@ -43,6 +43,18 @@ def canonical_pivot(direction: np.ndarray, pivot: np.ndarray, grasp_point: np.nd
     return pivot + float((grasp_point - pivot) @ u) * u
 
 
+def away_from_joint(est: JointAxisEstimate) -> np.ndarray:
+    """Unit world direction (3,) away from the joint at ``est``'s grasp point: along the radius from
+    the axis (revolute; zeros when the grasp point lies on the axis) or along the axis (prismatic)."""
+    u = unit(est.direction)
+    if est.joint_type == "prismatic":
+        return u
+    radial = est.grasp_point - est.pivot
+    radial = radial - float(radial @ u) * u
+    norm = float(np.linalg.norm(radial))
+    return radial / norm if norm > 1e-9 else np.zeros(3)
+
+
 def unit(v: np.ndarray) -> np.ndarray:
     """``v / |v|``; raises ValueError for a (near) zero vector."""
     n = float(np.linalg.norm(v))

@@ -15,6 +15,7 @@ from capt_env.wrappers.config import NoiseConfig
 from capt_env.wrappers.estimate import (
     JOINT_TYPES,
     JointAxisEstimate,
+    away_from_joint,
     canonical_pivot,
     grasp_point_of_part,
     unit,
@@ -82,24 +83,13 @@ def tilt(direction: np.ndarray, angle: float, rng: np.random.Generator) -> np.nd
     return np.cos(angle) * u + np.sin(angle) * perp
 
 
-def outward(est: JointAxisEstimate) -> np.ndarray:
-    """Unit world direction away from the joint at the grasp point: along the radius from the axis
-    (revolute; zeros on the axis) or along the axis (prismatic)."""
-    u = unit(est.direction)
-    if est.joint_type == "prismatic":
-        return u
-    radial = est.grasp_point - est.pivot
-    radial = radial - float(radial @ u) * u
-    norm = float(np.linalg.norm(radial))
-    return radial / norm if norm > 1e-9 else np.zeros(3)
-
-
 class NoisyOracleSource:
     """Ground truth plus Gaussian noise of the magnitudes in :class:`NoiseConfig`, seeded.
 
     The direction is tilted by ``|N(0, direction_rad)|`` radians; the grasp point moves
-    ``grasp_outward_m`` along :func:`outward`, plus noise; the noisy pivot is then made canonical
-    again (closest to the noisy grasp point) so only the off-axis part of the pivot noise remains.
+    ``grasp_outward_m`` along :func:`~capt_env.wrappers.estimate.away_from_joint`, plus noise; the
+    noisy pivot is then made canonical again (closest to the noisy grasp point) so only the off-axis
+    part of the pivot noise remains.
     """
 
     needs_points = False
@@ -112,7 +102,7 @@ class NoisyOracleSource:
         gt = ground_truth_estimate(info)
         n, rng = self.noise, self.rng
         direction = tilt(gt.direction, abs(float(rng.normal(0.0, n.direction_rad))), rng)
-        grasp = gt.grasp_point + n.grasp_outward_m * outward(gt) + rng.normal(0.0, n.grasp_m, size=3)
+        grasp = gt.grasp_point + n.grasp_outward_m * away_from_joint(gt) + rng.normal(0.0, n.grasp_m, size=3)
         pivot = canonical_pivot(direction, gt.pivot + rng.normal(0.0, n.pivot_m, size=3), grasp)
         state = gt.state + float(rng.normal(0.0, n.state))
         return JointAxisEstimate(gt.joint_type, direction, pivot, state, grasp, confidence=1.0)
