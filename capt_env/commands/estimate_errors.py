@@ -27,6 +27,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
     parser.add_argument("--hinge-on-part-edge", default="both", choices=["both", "on", "off"],
                         help="score the wrapper with the hinge-on-edge check, without it, or both")
+    parser.add_argument("--dense-geometry", default="on", choices=["both", "on", "off"],
+                        help="look for handles among all isolated points (on), only CAPT's "
+                             "downsampled input (off), or score both")
     add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
 
@@ -54,7 +57,12 @@ def _summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
             "line_m_mean": float(np.mean(lines)) if lines else None,
             "line_m_median": float(np.median(lines)) if lines else None,
             "grasp_m_mean": float(np.mean([r["grasp_m"] for r in rows])),
+            "grasp_far": float(np.mean([r["grasp_m"] > 0.1 for r in rows])),
             "type_right": float(np.mean([r["type_right"] for r in rows]))}
+
+
+def _on(flag: bool) -> str:
+    return "on" if flag else "off"
 
 
 def _cm(v: float | None) -> str:
@@ -70,30 +78,35 @@ def run(args: argparse.Namespace) -> int:
 
     if args.resets < 1:
         raise SystemExit(f"--resets must be >= 1, got {args.resets}")
-    flags = {"both": [False, True], "on": [True], "off": [False]}[args.hinge_on_part_edge]
+    choices = {"both": [False, True], "on": [True], "off": [False]}
+    flags = [(hinge, dense) for hinge in choices[args.hinge_on_part_edge]
+             for dense in choices[args.dense_geometry]]
     seeds = list(range(args.first_seed, args.first_seed + args.resets))
     task = task_overrides(args.task)
-    header = ("| category | hinge on part edge | direction (deg) | sign right | line (cm, mean) | "
-              "line (cm, median) | grasp point (cm) | resets |")
-    table, results = [header, "|" + " --- |" * 8], []
+    header = ("| category | hinge on part edge | dense geometry | direction (deg) | sign right | "
+              "line (cm, mean) | line (cm, median) | grasp point (cm) | grasp > 10 cm | resets |")
+    table, results = [header, "|" + " --- |" * 10], []
     for category in args.categories:
-        for flag in flags:
+        for flag, dense in flags:
             wrapper = {"source": "capt", "every_k_steps": 1, "hinge_on_part_edge": flag,
+                       "dense_geometry": dense,
                        "checkpoint": str(args.checkpoint or default_checkpoint(category))}
             env = make_env(category, wrapper, task=task, obs_mode="pointcloud")
             rows = []
             try:
-                for seed in tqdm(seeds, desc=f"{category} hinge-on-edge {'on' if flag else 'off'}",
-                                 leave=False):
+                desc = f"{category} hinge-on-edge {_on(flag)} dense {_on(dense)}"
+                for seed in tqdm(seeds, desc=desc, leave=False):
                     _, info = env.reset(seed=seed)
                     rows.append({"seed": seed, **estimate_errors(env.estimate, ground_truth_estimate(info))})
             finally:
                 env.close()
             s = _summary(rows)
-            results.append({"category": category, "hinge_on_part_edge": flag, **s, "per_reset": rows})
-            table.append(f"| {category.replace('_', ' ')} | {'on' if flag else 'off'} | "
+            results.append({"category": category, "hinge_on_part_edge": flag, "dense_geometry": dense,
+                            **s, "per_reset": rows})
+            table.append(f"| {category.replace('_', ' ')} | {_on(flag)} | {_on(dense)} | "
                          f"{s['direction_deg_mean']:.1f} | {s['sign_right']:.2f} | {_cm(s['line_m_mean'])} | "
-                         f"{_cm(s['line_m_median'])} | {100 * s['grasp_m_mean']:.1f} | {s['resets']} |")
+                         f"{_cm(s['line_m_median'])} | {100 * s['grasp_m_mean']:.1f} | "
+                         f"{s['grasp_far']:.2f} | {s['resets']} |")
     text = "\n".join(table)
     print(text)
     if args.markdown:

@@ -86,7 +86,9 @@ class PerceptionWrapperConfig:
     drawers, numbered from the bottom as in the dataset), the target drawer's grasp point is the
     target-index-th handle from the bottom on the stack's front (``stacked_parts``), not the handle
     of the part CAPT labels with the target's index (it often gives a drawer its neighbour's label);
-    with fewer handles in view, CAPT's label decides.
+    with fewer handles in view, CAPT's label decides. ``dense_geometry`` (``capt`` only): look for
+    handles among all isolated object points rather than the ``num_points`` fed to CAPT (a handle is
+    a few of those, kept by one draw and lost by the next).
     """
 
     source: Source = "oracle"
@@ -99,6 +101,7 @@ class PerceptionWrapperConfig:
     seed: int = 0
     hinge_on_part_edge: bool = True
     order_stacked_parts: bool = True
+    dense_geometry: bool = True
 
     def validate(self) -> None:
         require(self.every_k_steps >= 1, f"every_k_steps must be >= 1, got {self.every_k_steps}")

@@ -9,6 +9,12 @@ episode). The pivot, and the grasp point while the part has not moved (state wit
 them and coordinate-wise weighted medians from three on, so one grasp point found on the wrong part
 is outvoted. Once the part moves, the latest grasp point is used. The state is always the latest
 estimate.
+
+An estimate whose grasp point was found on a handle (``from_handle``) is worth more than one whose
+grasp point fell back to the part's far edge: a hand on the handle hides it, and the fallback
+(and the hinge line placed away from it) can land on the wrong side of the part. Once any estimate
+found the handle, the pivot and the grasp point come from those only, and a moved part's grasp
+point is the latest one found on the handle.
 """
 
 from __future__ import annotations
@@ -43,36 +49,43 @@ class EstimateFusion:
         self._weight = 0.0
         self._direction = np.zeros(3)
         self._signed: list[tuple[float, np.ndarray]] = []
-        self._pivots: list[np.ndarray] = []
-        self._weights: list[float] = []
-        self._grasps: list[np.ndarray] = []
-        self._grasp_weights: list[float] = []
+        self._pivots: list[tuple[np.ndarray, float, bool]] = []  # (pivot, weight, from_handle)
+        self._grasps: list[tuple[np.ndarray, float, bool]] = []  # while the part has not moved
+        self._handle_grasp: np.ndarray | None = None  # the latest grasp point found on the handle
         self._first_state: float | None = None
 
-    def update(self, estimate: JointAxisEstimate) -> JointAxisEstimate:
-        """Add ``estimate`` (world frame) and return the fused estimate."""
+    def update(self, estimate: JointAxisEstimate, from_handle: bool = True) -> JointAxisEstimate:
+        """Add ``estimate`` (world frame) and return the fused estimate. ``from_handle``: its grasp
+        point was found on a handle (not the fallback far edge of the part)."""
         w = max(float(estimate.confidence), 1e-3)
         d = unit(estimate.direction)
         self._signed.append((w, d))
         aligned = -d if self._weight > 0 and float(self._direction @ d) < 0 else d
         self._direction += w * aligned
         self._weight += w
-        self._pivots.append(np.asarray(estimate.pivot, dtype=np.float64))
-        self._weights.append(w)
+        self._pivots.append((np.asarray(estimate.pivot, dtype=np.float64), w, from_handle))
+        latest = np.asarray(estimate.grasp_point, dtype=np.float64)
+        if from_handle:
+            self._handle_grasp = latest
         if self._first_state is None:
             self._first_state = float(estimate.state)
         moved = abs(float(estimate.state) - self._first_state) > self.state_tolerance
         if moved:
-            grasp = np.asarray(estimate.grasp_point, dtype=np.float64)
+            grasp = latest if from_handle or self._handle_grasp is None else self._handle_grasp
         else:
-            self._grasps.append(np.asarray(estimate.grasp_point, dtype=np.float64))
-            self._grasp_weights.append(w)
-            grasp = robust_centre(self._grasps, self._grasp_weights)
+            self._grasps.append((latest, w, from_handle))
+            grasp = robust_centre(*_trusted(self._grasps))
         direction = unit(self._direction)
         vote = sum(wi * float(np.sign(di @ direction)) for wi, di in self._signed)
         if vote < 0:
             direction = -direction
-        pivot = canonical_pivot(direction, robust_centre(self._pivots, self._weights), grasp)
+        pivot = canonical_pivot(direction, robust_centre(*_trusted(self._pivots)), grasp)
         agreement = float(np.linalg.norm(self._direction) / self._weight)
         return JointAxisEstimate(estimate.joint_type, direction, pivot, float(estimate.state), grasp,
                                  float(min(1.0, agreement * estimate.confidence)))
+
+
+def _trusted(entries: list[tuple[np.ndarray, float, bool]]) -> tuple[list[np.ndarray], list[float]]:
+    """(points, weights) of the entries found on a handle, or of all entries when none was."""
+    kept = [e for e in entries if e[2]] or entries
+    return [e[0] for e in kept], [e[1] for e in kept]

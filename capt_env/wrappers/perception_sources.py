@@ -31,14 +31,19 @@ from capt_env.wrappers.moving_part_geometry import (
 )
 from capt_env.wrappers.stacked_parts import kth_handle_from_bottom
 
+_MIN_HANDLE_POINTS = 3  # of the model's input cloud: fewer are noise, not a handle
+
 
 class PerceptionSource(Protocol):
     """Anything that estimates the target joint. ``needs_points``: whether it reads the cloud."""
 
     needs_points: bool
 
-    def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
-        """Estimate from object points (M, 3) world frame metres (or None) and the env's info."""
+    def estimate(self, points: np.ndarray | None, info: dict[str, Any],
+                 dense_points: np.ndarray | None = None) -> JointAxisEstimate:
+        """Estimate from object points (M, 3) world frame metres (or None) and the env's info.
+        ``dense_points`` (K, 3), K >= M: all isolated object points before downsampling, for
+        geometry that needs more than the model's input (a source may ignore them)."""
         ...
 
 
@@ -71,7 +76,8 @@ class OracleSource:
 
     needs_points = False
 
-    def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
+    def estimate(self, points: np.ndarray | None, info: dict[str, Any],
+                 dense_points: np.ndarray | None = None) -> JointAxisEstimate:
         return ground_truth_estimate(info)
 
 
@@ -98,7 +104,8 @@ class NoisyOracleSource:
         self.noise = noise
         self.rng = np.random.default_rng(seed)
 
-    def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
+    def estimate(self, points: np.ndarray | None, info: dict[str, Any],
+                 dense_points: np.ndarray | None = None) -> JointAxisEstimate:
         gt = ground_truth_estimate(info)
         n, rng = self.noise, self.rng
         direction = tilt(gt.direction, abs(float(rng.normal(0.0, n.direction_rad))), rng)
@@ -119,6 +126,10 @@ class CaptSource:
     the bottom on the stack's front when that many are in view (``stacked_parts``).
     The axis sign is set so that opening moves the part away from its body
     (``opening_direction``): CAPT often gets a hinge's sign wrong while the line is right.
+    With ``dense_geometry`` handles are looked for among all isolated points (``dense_points``), not
+    only the model's downsampled input, where a handle is a handful of points that one draw keeps
+    and the next loses (the grasp point then falls back to the part's far edge); the minimum
+    handle size scales with the density, so it is the same share of the cloud.
     Successive estimates within an episode are fused (see ``estimate_fusion``);
     :meth:`reset` starts a new episode.
     """
@@ -126,11 +137,12 @@ class CaptSource:
     needs_points = True
 
     def __init__(self, checkpoint: str, seed: int = 0, hinge_on_part_edge: bool = False,
-                 order_stacked_parts: bool = False) -> None:
+                 order_stacked_parts: bool = False, dense_geometry: bool = False) -> None:
         self.checkpoint = checkpoint
         self.seed = seed
         self.hinge_on_part_edge = hinge_on_part_edge
         self.order_stacked_parts = order_stacked_parts
+        self.dense_geometry = dense_geometry
         self._estimator: Any = None
         self._fusion = EstimateFusion()
 
@@ -146,11 +158,13 @@ class CaptSource:
         return self._estimator
 
     @staticmethod
-    def _stacked_handle(points: np.ndarray, result: Any, model: Any, k: int,
+    def _stacked_handle(points: np.ndarray, geometry: np.ndarray, min_points: int, result: Any,
+                        model: Any, k: int,
                         direction: np.ndarray) -> tuple[PartPlane | None, np.ndarray | None]:
-        """(front plane, k-th handle from the bottom) of a stack of prismatic parts, or (None, None)
-        when the model has fewer than two prismatic joints, the front is not flat or does not face
-        along the slide ``direction``, or fewer than k + 1 handles are in view."""
+        """(front plane, k-th handle from the bottom among ``geometry`` points) of a stack of
+        prismatic parts, or (None, None) when the model has fewer than two prismatic joints, the
+        front is not flat or does not face along the slide ``direction``, or fewer than k + 1
+        handles are in view."""
         stacked = [int(c) for c, t in zip(model.joint_child_parts, model.joint_types, strict=False)
                    if t == "prismatic"]
         if len(stacked) < 2:
@@ -159,12 +173,17 @@ class CaptSource:
         plane = part_plane(points, front)
         if not faces_along(plane, direction):
             return None, None
-        handle = kth_handle_from_bottom(points, front, k, plane=plane)
+        handle = kth_handle_from_bottom(geometry, front, k, plane=plane, min_points=min_points)
         return (plane, handle) if handle is not None else (None, None)
 
-    def estimate(self, points: np.ndarray | None, info: dict[str, Any]) -> JointAxisEstimate:
+    def estimate(self, points: np.ndarray | None, info: dict[str, Any],
+                 dense_points: np.ndarray | None = None) -> JointAxisEstimate:
         if points is None:
             raise ValueError("the capt source needs the object's points")
+        geometry, min_points = points, _MIN_HANDLE_POINTS
+        if self.dense_geometry and dense_points is not None and len(dense_points) > len(points):
+            geometry = np.asarray(dense_points, dtype=np.float64)
+            min_points = max(_MIN_HANDLE_POINTS, round(_MIN_HANDLE_POINTS * len(geometry) / len(points)))
         est = self._load()
         result = est.predict(np.asarray(points, dtype=np.float64))
         k = min(_target(info), len(result.joints) - 1)
@@ -178,7 +197,8 @@ class CaptSource:
         direction = unit(joint.direction)
         plane, grasp = None, None
         if self.order_stacked_parts and joint.type == "prismatic" and child_parts is not None:
-            plane, grasp = self._stacked_handle(points, result, est.config.model, k, direction)
+            plane, grasp = self._stacked_handle(points, geometry, min_points, result, est.config.model,
+                                                k, direction)
         if grasp is None:
             plane = part_plane(points, moving)
             if joint.type == "prismatic" and not faces_along(plane, direction):
@@ -186,7 +206,8 @@ class CaptSource:
         if plane is not None and self.hinge_on_part_edge and joint.type == "revolute":
             direction = edge_aligned_direction(direction, plane, moving)
         if grasp is None and plane is not None:
-            grasp = handle_point(points, moving, plane=plane)
+            grasp = handle_point(geometry, moving, plane=plane, min_points=min_points)
+        from_handle = grasp is not None
         if plane is not None and joint.type == "prismatic":
             # before the grasp point: the front-most points along a wrongly signed slide are the back
             # (a prismatic opening direction does not depend on the pivot or grasp point)
@@ -200,11 +221,12 @@ class CaptSource:
         if plane is not None and joint.type == "revolute":
             direction = opening_direction(joint.type, direction, pivot, grasp, plane.outward)
         return self._fusion.update(JointAxisEstimate(joint.type, direction, pivot, float(joint.state),
-                                                     grasp, float(joint.confidence)))
+                                                     grasp, float(joint.confidence)), from_handle)
 
 
 def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: int,
-                hinge_on_part_edge: bool = False, order_stacked_parts: bool = False) -> PerceptionSource:
+                hinge_on_part_edge: bool = False, order_stacked_parts: bool = False,
+                dense_geometry: bool = False) -> PerceptionSource:
     """The source named ``source`` ("oracle", "noisy_oracle", "capt")."""
     if source == "oracle":
         return OracleSource()
@@ -213,5 +235,5 @@ def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: i
     if source == "capt":
         if checkpoint is None:
             raise ValueError("source 'capt' needs a checkpoint path")
-        return CaptSource(checkpoint, seed, hinge_on_part_edge, order_stacked_parts)
+        return CaptSource(checkpoint, seed, hinge_on_part_edge, order_stacked_parts, dense_geometry)
     raise ValueError(f"unknown perception source {source!r}")

@@ -50,7 +50,8 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         cfg.validate()
         self.config = cfg
         self.source: PerceptionSource = make_source(cfg.source, cfg.noise, cfg.checkpoint, cfg.seed,
-                                                     cfg.hinge_on_part_edge, cfg.order_stacked_parts)
+                                                     cfg.hinge_on_part_edge, cfg.order_stacked_parts,
+                                                     cfg.dense_geometry)
         obs_mode = getattr(env.unwrapped, "obs_mode", None)
         if self.source.needs_points and obs_mode != "pointcloud":
             raise ValueError(
@@ -92,7 +93,6 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     # ----------------------------------------------------------------- parts
     def _perceive(self, obs: Any, info: dict) -> float:
         t0 = time.perf_counter()
-        points = None
         if self.source.needs_points:
             points = self._object_cloud(obs)
             if len(points) < 32:  # nothing to see: keep the last estimate
@@ -100,8 +100,11 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
                     self._estimate = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3),
                                                        0.0, np.zeros(3), 0.0)
                 return (time.perf_counter() - t0) * 1000.0
+            dense = points
             points = downsample(points, self.config.num_points, self._rng)
-        self._estimate = self.source.estimate(points, info)
+            self._estimate = self.source.estimate(points, info, dense_points=dense)
+        else:
+            self._estimate = self.source.estimate(None, info)
         return (time.perf_counter() - t0) * 1000.0
 
     def _object_cloud(self, obs: Any) -> np.ndarray:

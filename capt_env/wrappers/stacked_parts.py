@@ -51,14 +51,14 @@ def handle_groups(object_points: np.ndarray, front_points: np.ndarray, plane: Pa
 
 
 def kth_handle_from_bottom(object_points: np.ndarray, front_points: np.ndarray, k: int,
-                           plane: PartPlane | None = None) -> np.ndarray | None:
+                           plane: PartPlane | None = None, min_points: int = 3) -> np.ndarray | None:
     """Centre (3,) of the ``k``-th handle from the bottom on a stack's front (see
     :func:`handle_groups`), world frame, metres; None when fewer than ``k + 1`` handles are seen.
     The centre is the middle of the handle's extent along its main direction (a bar's visible
-    points are denser at one end)."""
+    points are denser at one end). ``min_points``: the fewest points of a handle."""
     if k < 0:
         raise ValueError(f"k must be >= 0, got {k}")
-    groups = handle_groups(object_points, front_points, plane=plane)
+    groups = handle_groups(object_points, front_points, plane=plane, min_points=min_points)
     if len(groups) <= k:
         return None
     return bar_centre(groups[k])

@@ -49,3 +49,24 @@ def test_a_bad_first_look_is_outvoted() -> None:
     assert fused.direction[2] > 0.99  # three votes to one
     np.testing.assert_allclose(fused.grasp_point, [0.04, -0.05, 0.19], atol=0.011)
     np.testing.assert_allclose(fused.pivot[:2], [0.15, -0.2], atol=0.011)
+
+
+def test_estimates_found_on_the_handle_outvote_far_edge_fallbacks() -> None:
+    """A door's handle is hidden in two looks of three (the grasp point fell back to the hinge side and
+    the hinge line went to the handle side): the one look that found the handle decides."""
+    fusion = EstimateFusion()
+    handle, hinge = (0.05, 0.11, 0.27), (0.19, -0.27, 0.27)
+    fusion.update(est([0, 0, 1], [0.19, 0.13, 0.0], grasp=(0.06, -0.25, 0.27)), from_handle=False)
+    fusion.update(est([0, 0, 1], hinge, grasp=handle), from_handle=True)
+    fused = fusion.update(est([0, 0, 1], [0.19, 0.13, 0.0], grasp=(0.06, -0.25, 0.27)), from_handle=False)
+    np.testing.assert_allclose(fused.grasp_point, handle)
+    np.testing.assert_allclose(fused.pivot[:2], hinge[:2])
+    # the part moved and the hand hides the handle: the last grasp point found on it is kept
+    moved = fusion.update(est([0, 0, 1], [0.19, 0.13, 0.0], state=0.5, grasp=(0.3, -0.3, 0.27)),
+                          from_handle=False)
+    np.testing.assert_allclose(moved.grasp_point, handle)
+    # with no handle ever found (a lid), every estimate counts as before
+    lid = EstimateFusion()
+    lid.update(est([0, 0, 1], [0.0, 0.0, 0.0], grasp=(0.3, 0.0, 0.2)), from_handle=False)
+    fused = lid.update(est([0, 0, 1], [0.0, 0.1, 0.0], grasp=(0.3, 0.1, 0.2)), from_handle=False)
+    np.testing.assert_allclose(fused.grasp_point, [0.3, 0.05, 0.2], atol=1e-9)
