@@ -13,8 +13,9 @@ estimate.
 An estimate whose grasp point was found on a handle (``from_handle``) is worth more than one whose
 grasp point fell back to the part's far edge: a hand on the handle hides it, and the fallback
 (and the hinge line placed away from it) can land on the wrong side of the part. Once any estimate
-found the handle, the pivot and the grasp point come from those only, and a moved part's grasp
-point is the latest one found on the handle.
+found the handle, the pivot and the grasp point come from those only; a moved part whose handle is
+not seen now has its last handle point carried with the part to the current state (turned about
+the fused axis, or slid along it), as the handle moves rigidly with the part.
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ class EstimateFusion:
         self._signed: list[tuple[float, np.ndarray]] = []
         self._pivots: list[tuple[np.ndarray, float, bool]] = []  # (pivot, weight, from_handle)
         self._grasps: list[tuple[np.ndarray, float, bool]] = []  # while the part has not moved
-        self._handle_grasp: np.ndarray | None = None  # the latest grasp point found on the handle
+        self._handle_grasp: tuple[np.ndarray, float] | None = None  # latest (point, state) on the handle
         self._first_state: float | None = None
 
     def update(self, estimate: JointAxisEstimate, from_handle: bool = True) -> JointAxisEstimate:
@@ -65,24 +66,42 @@ class EstimateFusion:
         self._weight += w
         self._pivots.append((np.asarray(estimate.pivot, dtype=np.float64), w, from_handle))
         latest = np.asarray(estimate.grasp_point, dtype=np.float64)
+        state = float(estimate.state)
         if from_handle:
-            self._handle_grasp = latest
+            self._handle_grasp = (latest, state)
         if self._first_state is None:
-            self._first_state = float(estimate.state)
-        moved = abs(float(estimate.state) - self._first_state) > self.state_tolerance
-        if moved:
-            grasp = latest if from_handle or self._handle_grasp is None else self._handle_grasp
-        else:
-            self._grasps.append((latest, w, from_handle))
-            grasp = robust_centre(*_trusted(self._grasps))
+            self._first_state = state
         direction = unit(self._direction)
         vote = sum(wi * float(np.sign(di @ direction)) for wi, di in self._signed)
         if vote < 0:
             direction = -direction
-        pivot = canonical_pivot(direction, robust_centre(*_trusted(self._pivots)), grasp)
+        line_point = robust_centre(*_trusted(self._pivots))
+        if abs(state - self._first_state) <= self.state_tolerance:  # the part has not moved
+            self._grasps.append((latest, w, from_handle))
+            grasp = robust_centre(*_trusted(self._grasps))
+        elif from_handle or self._handle_grasp is None:
+            grasp = latest
+        else:
+            handle, handle_state = self._handle_grasp
+            grasp = moved_with_part(handle, estimate.joint_type, direction, line_point,
+                                    state - handle_state)
+        pivot = canonical_pivot(direction, line_point, grasp)
         agreement = float(np.linalg.norm(self._direction) / self._weight)
         return JointAxisEstimate(estimate.joint_type, direction, pivot, float(estimate.state), grasp,
                                  float(min(1.0, agreement * estimate.confidence)))
+
+
+def moved_with_part(point: np.ndarray, joint_type: str, direction: np.ndarray, line_point: np.ndarray,
+                    delta: float) -> np.ndarray:
+    """``point`` (3,) on a part, moved with the part by ``delta`` of its joint state: turned by
+    ``delta`` rad about the line through ``line_point`` along unit ``direction`` (right hand;
+    revolute) or slid ``delta`` m along ``direction`` (prismatic). World frame, metres."""
+    if joint_type == "prismatic":
+        return point + delta * direction
+    v = point - line_point
+    c, s = np.cos(delta), np.sin(delta)
+    turned = v * c + np.cross(direction, v) * s + direction * float(direction @ v) * (1.0 - c)
+    return line_point + turned
 
 
 def _trusted(entries: list[tuple[np.ndarray, float, bool]]) -> tuple[list[np.ndarray], list[float]]:

@@ -61,12 +61,28 @@ def test_estimates_found_on_the_handle_outvote_far_edge_fallbacks() -> None:
     fused = fusion.update(est([0, 0, 1], [0.19, 0.13, 0.0], grasp=(0.06, -0.25, 0.27)), from_handle=False)
     np.testing.assert_allclose(fused.grasp_point, handle)
     np.testing.assert_allclose(fused.pivot[:2], hinge[:2])
-    # the part moved and the hand hides the handle: the last grasp point found on it is kept
+    # the door turned 0.5 rad and the hand hides the handle: the handle point found before turns with
+    # the door about the fused hinge (z through (0.19, -0.27))
     moved = fusion.update(est([0, 0, 1], [0.19, 0.13, 0.0], state=0.5, grasp=(0.3, -0.3, 0.27)),
                           from_handle=False)
-    np.testing.assert_allclose(moved.grasp_point, handle)
+    c, s = np.cos(0.5), np.sin(0.5)
+    rel = np.array([0.05 - 0.19, 0.11 + 0.27])
+    turned = [0.19 + c * rel[0] - s * rel[1], -0.27 + s * rel[0] + c * rel[1], 0.27]
+    np.testing.assert_allclose(moved.grasp_point, turned, atol=1e-9)
+    assert moved.grasp_point[0] < handle[0]  # towards the robot (-x): the door opened
     # with no handle ever found (a lid), every estimate counts as before
     lid = EstimateFusion()
     lid.update(est([0, 0, 1], [0.0, 0.0, 0.0], grasp=(0.3, 0.0, 0.2)), from_handle=False)
     fused = lid.update(est([0, 0, 1], [0.0, 0.1, 0.0], grasp=(0.3, 0.1, 0.2)), from_handle=False)
     np.testing.assert_allclose(fused.grasp_point, [0.3, 0.05, 0.2], atol=1e-9)
+
+
+
+def test_moved_with_part_turns_and_slides() -> None:
+    from capt_env.wrappers.estimate_fusion import moved_with_part
+
+    p = np.array([1.0, 0.0, 0.5])
+    turned = moved_with_part(p, "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.pi / 2)
+    np.testing.assert_allclose(turned, [0.0, 1.0, 0.5], atol=1e-12)  # right-handed about +z
+    slid = moved_with_part(p, "prismatic", np.array([-1.0, 0.0, 0.0]), np.zeros(3), 0.2)
+    np.testing.assert_allclose(slid, [0.8, 0.0, 0.5])
