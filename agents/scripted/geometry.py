@@ -50,3 +50,28 @@ def swept_angle(axis: np.ndarray, pivot: np.ndarray, start: np.ndarray, now: np.
     if np.linalg.norm(a) < 1e-6 or np.linalg.norm(b) < 1e-6:
         return 0.0
     return float(np.arctan2(float(np.cross(a, b) @ axis), float(a @ b)))
+
+
+def fit_circle(points: np.ndarray, axis: np.ndarray) -> tuple[np.ndarray, float, float] | None:
+    """Least-squares circle through ``points`` (M, 3) seen along unit ``axis`` (3,): (centre (3,),
+    radius, rms distance of the points from the circle), metres, world frame. The centre lies in the
+    plane through the points' mean perpendicular to ``axis``; components along ``axis`` are ignored.
+    None for fewer than 3 points or collinear ones."""
+    pts = np.asarray(points, dtype=np.float64)
+    if len(pts) < 3:
+        return None
+    e1 = perpendicular(axis, np.array([1.0, 0.0, 0.0]))
+    if e1 is None:
+        e1 = perpendicular(axis, np.array([0.0, 1.0, 0.0]))
+    assert e1 is not None
+    e2 = np.cross(axis, e1)
+    mean = pts.mean(axis=0)
+    xy = np.stack([(pts - mean) @ e1, (pts - mean) @ e2], axis=1)
+    # x^2 + y^2 = 2 a x + 2 b y + c: linear in (a, b, c); the centre is (a, b)
+    design = np.column_stack([2.0 * xy, np.ones(len(xy))])
+    (a, b, c), _, rank, _ = np.linalg.lstsq(design, (xy ** 2).sum(axis=1), rcond=None)
+    if rank < 3:
+        return None
+    radius = float(np.sqrt(max(c + a * a + b * b, 0.0)))
+    rms = float(np.sqrt(np.mean((np.linalg.norm(xy - [a, b], axis=1) - radius) ** 2)))
+    return mean + a * e1 + b * e2, radius, rms

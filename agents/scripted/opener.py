@@ -25,7 +25,9 @@ Strategy, per episode:
    steeply down, the fingertips slide in under the grasp point, then push along the arc as in 4.
 4. ``PULL``: the part's state is measured by the hand itself while it holds the part (the grasp-time
    estimate plus the TCP's swept angle about the estimated axis, or its travel along it), every
-   step and free of the perceived state's noise. The target TCP position is the grasp position moved
+   step and free of the perceived state's noise. About a hinge, once the holding hand's path is
+   long enough, the centre of the circle it follows replaces the estimated pivot (``arc_fit``).
+   The target TCP position is the grasp position moved
    with the part to state ``state_now + lead``: rotated about the estimated axis (revolute) or
    shifted along it (prismatic); the hand turns fully with a door on a vertical hinge and by
    ``wrist_follow`` of the angle about other hinges. The estimate is re-read every step, so
@@ -52,6 +54,7 @@ from agents.scripted.config import ScriptedOpenerConfig
 from agents.scripted.geometry import (
     axis_angle_matrix,
     clip_norm,
+    fit_circle,
     grasp_frame,
     perpendicular,
     quat_to_matrix,
@@ -211,6 +214,7 @@ class ScriptedOpener:
         self._lid = False
         self._lift = False
         self._history: list[float] = []
+        self._path: list[np.ndarray] = []
         self._slip_count = 0
         self._retreat_from: np.ndarray | None = None
         self._grasp_again = False
@@ -340,6 +344,7 @@ class ScriptedOpener:
     def _start_pull(self, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate) -> None:
         self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
         self._history = []
+        self._path = [p.copy()]
         self._slip_count = 0
         self._set(Phase.PULL)
 
@@ -355,6 +360,26 @@ class ScriptedOpener:
         recent = steps[-cfg.limit_window:]
         return cruise >= cfg.limit_min_speed_m and bool(np.all(recent < cfg.limit_slowdown * cruise))
 
+    def _hinge_pivot(self, u: np.ndarray, pivot: np.ndarray, p: np.ndarray,
+                     finger_gap: float | None) -> np.ndarray:
+        """The pivot (3,) to pull about: the centre of the circle the holding hand's path follows
+        about unit axis ``u`` when ``arc_fit`` accepts it (see the config), else the estimated
+        ``pivot``. ``p``: the TCP position now, added to the path while the fingers hold."""
+        cfg = self.cfg
+        if not cfg.arc_fit or finger_gap is None or finger_gap < cfg.hold_gap:
+            return pivot
+        self._path.append(p.copy())
+        path = np.asarray(self._path)
+        if np.linalg.norm(path - path[0], axis=1).max() < cfg.arc_fit_min_chord:
+            return pivot
+        fit = fit_circle(path, u)
+        if fit is None or fit[2] > cfg.arc_fit_max_rms:
+            return pivot
+        offset = fit[0] - pivot
+        if np.linalg.norm(offset - float(offset @ u) * u) > cfg.arc_fit_max_shift:
+            return pivot
+        return fit[0]
+
     def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
               finger_gap: float | None = None) -> np.ndarray:
         cfg = self.cfg
@@ -363,8 +388,9 @@ class ScriptedOpener:
         u = unit(est.direction)
         # while the hand holds the part, its own travel along the estimated arc or line measures the
         # part's state every step; the perceived state is noisier and only as fresh as the last estimate
+        pivot = self._hinge_pivot(u, est.pivot, p, finger_gap) if revolute else est.pivot
         if revolute:
-            state = self._grasp_state + swept_angle(u, est.pivot, self._grasp_p, p)
+            state = self._grasp_state + swept_angle(u, pivot, self._grasp_p, p)
         else:
             state = self._grasp_state + float((p - self._grasp_p) @ u)
         self._history.append(state)
@@ -398,7 +424,7 @@ class ScriptedOpener:
             return action
         if revolute:
             delta = state - self._grasp_state + cfg.revolute_lead
-            p_des = est.pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - est.pivot)
+            p_des = pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - pivot)
             if is_vertical_hinge(est, cfg):
                 follow = 1.0
             elif self._lid:

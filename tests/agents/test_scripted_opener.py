@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
-from agents.scripted.geometry import axis_angle_matrix, swept_angle
+from agents.scripted.geometry import axis_angle_matrix, fit_circle, swept_angle
 from agents.scripted.opener import Phase, grasp_rotation, grasp_target, is_lid, lift_pose, outward_normal
 from agents.scripted.rollout import make_env, run_episode
 from capt_env.wrappers.estimate import JointAxisEstimate
@@ -91,6 +91,34 @@ def test_swept_angle_is_signed_and_ignores_travel_along_the_axis() -> None:
         now = pivot + axis_angle_matrix(axis, angle) @ (start - pivot) + np.array([0.0, 0.0, 0.1])
         assert swept_angle(axis, pivot, start, now) == pytest.approx(angle, abs=1e-9)
     assert swept_angle(axis, pivot, start, pivot + np.array([0.0, 0.0, 0.2])) == 0.0
+
+
+def test_fit_circle_recovers_a_hinge_from_an_arc() -> None:
+    axis, centre = np.array([0.0, 0.0, 1.0]), np.array([0.2, -0.25, 0.3])
+    start = np.array([0.0, 0.12, 0.0])
+    arc = [centre + axis_angle_matrix(axis, a) @ start + [0, 0, 0.01 * a] for a in np.linspace(0, 0.5, 9)]
+    fitted, radius, rms = fit_circle(np.asarray(arc), axis)
+    np.testing.assert_allclose(fitted[:2], centre[:2], atol=1e-9)
+    assert radius == pytest.approx(0.12) and rms < 1e-9
+    assert fit_circle(np.asarray(arc[:2]), axis) is None
+
+
+def test_the_holding_hand_measures_a_hinge_the_estimate_has_off() -> None:
+    """A 20 cm door whose estimated hinge is 4 cm nearer the handle: about that pivot the hand reads
+    the swept angle too large (1.06 rad for 0.9); the circle its path follows gives it right."""
+    axis, hinge = np.array([0.0, 0.0, 1.0]), np.array([0.3, -0.2, 0.3])
+    grasp = hinge + np.array([-0.02, 0.2, 0.0])
+    estimate = JointAxisEstimate("revolute", axis, hinge + [0.0, 0.04, 0.0], 0.0, grasp)
+    def measured(cfg: ScriptedOpenerConfig) -> float:
+        opener = ScriptedOpener(cfg)
+        opener._start_pull(grasp, np.eye(3), estimate)
+        for a in np.linspace(0.0, 0.9, 19)[1:]:
+            p = hinge + axis_angle_matrix(axis, a) @ (grasp - hinge)
+            opener._pull(estimate, p, np.eye(3), finger_gap=0.02)
+        return opener._history[-1]
+
+    assert measured(ScriptedOpenerConfig(arc_fit=False)) > 1.05
+    assert measured(ScriptedOpenerConfig()) == pytest.approx(0.9, abs=0.01)
 
 
 def test_bad_opener_config_is_rejected() -> None:
