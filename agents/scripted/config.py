@@ -51,10 +51,12 @@ class ScriptedOpenerConfig:
     ``limit_window`` steps: the part has hit its end stop (pulled on, the handle would slide out of the
     fingers and a re-grasp would chase an open drawer). After release it backs off ``retreat_distance`` m.
     With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
-    fingers apart (holding), has moved ``arc_fit_min_chord`` m from where the pull began, a circle is
-    fitted to its path about the estimated axis direction; if the path lies within ``arc_fit_max_rms`` m
+    fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
+    estimated hinge) from where the pull began, a circle is fitted to its path about the estimated
+    axis direction; if the path lies within ``arc_fit_max_rms`` m
     of that circle and its centre is within ``arc_fit_max_shift`` m of the estimated line, the centre
-    replaces the estimated pivot for this pull (the swept angle and the arc the hand follows). A
+    replaces the estimated pivot for the rest of this pull (the swept angle and the arc the hand
+    follows; the first accepted fit is kept, as a hand slipping off the handle later leaves the arc). A
     pivot a few cm off the hinge of a 20 cm door reads the swept angle 0.4 rad too large, and the
     hand lets go short of open.
     """
@@ -104,6 +106,7 @@ class ScriptedOpenerConfig:
     release_steps: int = 6
     arc_fit: bool = True
     arc_fit_min_chord: float = 0.06
+    arc_fit_min_angle: float = 0.3
     arc_fit_max_rms: float = 0.004
     arc_fit_max_shift: float = 0.15
 
@@ -112,7 +115,7 @@ class ScriptedOpenerConfig:
                     "revolute_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
                     "revolute_target", "prismatic_target", "lid_revolute_target",
                     "slip_distance", "hold_gap", "limit_min_speed_m", "arc_fit_min_chord",
-                    "arc_fit_max_rms", "arc_fit_max_shift"):
+                    "arc_fit_min_angle", "arc_fit_max_rms", "arc_fit_max_shift"):
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         require(self.rotate_first_above > 0,
                 f"rotate_first_above must be > 0 rad, got {self.rotate_first_above}")

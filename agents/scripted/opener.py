@@ -210,11 +210,14 @@ class ScriptedOpener:
         self._grasp_p: np.ndarray | None = None
         self._grasp_r: np.ndarray | None = None
         self._grasp_state = 0.0
+        self._grasp_u: np.ndarray | None = None
         self._target_r: np.ndarray | None = None
         self._lid = False
         self._lift = False
         self._history: list[float] = []
-        self._path: list[np.ndarray] = []
+        self._pulled: list[np.ndarray] = []  # TCP positions of this pull, every step
+        self._held: list[np.ndarray] = []  # those while the fingers held the part
+        self._hinge_fit: np.ndarray | None = None  # the hinge pivot fitted to the held path
         self._slip_count = 0
         self._retreat_from: np.ndarray | None = None
         self._grasp_again = False
@@ -343,8 +346,11 @@ class ScriptedOpener:
 
     def _start_pull(self, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate) -> None:
         self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
+        self._grasp_u = unit(est.direction)
         self._history = []
-        self._path = [p.copy()]
+        self._pulled = [p.copy()]
+        self._held = [p.copy()]
+        self._hinge_fit = None
         self._slip_count = 0
         self._set(Phase.PULL)
 
@@ -368,9 +374,12 @@ class ScriptedOpener:
         cfg = self.cfg
         if not cfg.arc_fit or finger_gap is None or finger_gap < cfg.hold_gap:
             return pivot
-        self._path.append(p.copy())
-        path = np.asarray(self._path)
-        if np.linalg.norm(path - path[0], axis=1).max() < cfg.arc_fit_min_chord:
+        if self._hinge_fit is not None:
+            return self._hinge_fit
+        self._held.append(p.copy())
+        path = np.asarray(self._held)
+        if (np.linalg.norm(path - path[0], axis=1).max() < cfg.arc_fit_min_chord
+                or abs(swept_angle(u, pivot, path[0], p)) < cfg.arc_fit_min_angle):
             return pivot
         fit = fit_circle(path, u)
         if fit is None or fit[2] > cfg.arc_fit_max_rms:
@@ -378,6 +387,8 @@ class ScriptedOpener:
         offset = fit[0] - pivot
         if np.linalg.norm(offset - float(offset @ u) * u) > cfg.arc_fit_max_shift:
             return pivot
+        # kept for the rest of the pull: a hand that later slips off the handle leaves the arc
+        self._hinge_fit = fit[0]
         return fit[0]
 
     def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
@@ -386,6 +397,10 @@ class ScriptedOpener:
         assert self._grasp_p is not None and self._grasp_r is not None
         revolute = est.joint_type == "revolute"
         u = unit(est.direction)
+        if self._grasp_u is not None and float(u @ self._grasp_u) < 0.0:
+            # the part opens the way it did when the pull began: a re-estimate that flips the axis
+            # (the sign is what a single view gets wrong most) would read the opening as closing
+            u = -u
         # while the hand holds the part, its own travel along the estimated arc or line measures the
         # part's state every step; the perceived state is noisier and only as fresh as the last estimate
         pivot = self._hinge_pivot(u, est.pivot, p, finger_gap) if revolute else est.pivot
@@ -394,6 +409,7 @@ class ScriptedOpener:
         else:
             state = self._grasp_state + float((p - self._grasp_p) @ u)
         self._history.append(state)
+        self._pulled.append(p.copy())
         # a drawer runs freely up to its end stop, where the hand brakes before the handle slides out
         # of the fingers: that is the limit, and grasping again would chase a part that is open
         at_limit = not revolute and self._braked()
@@ -402,8 +418,13 @@ class ScriptedOpener:
         else:
             target = cfg.prismatic_target
         min_progress = cfg.stall_progress if revolute else cfg.stall_progress_m
-        stalled = (len(self._history) > cfg.stall_steps
-                   and self._history[-1] - self._history[-1 - cfg.stall_steps] < min_progress)
+        # progress over the last stall_steps, measured about the pivot in use now (arc_fit may
+        # have moved it, which changes the state read along the whole path, not the part's motion)
+        stalled = False
+        if len(self._pulled) > cfg.stall_steps + 1:
+            before = self._pulled[-1 - cfg.stall_steps]
+            progress = (swept_angle(u, pivot, before, p) if revolute else float((p - before) @ u))
+            stalled = progress < min_progress
         if state >= target or stalled or at_limit:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
             self._grasp_again = state < target and not at_limit and self.regrasps < cfg.max_regrasps
