@@ -34,6 +34,16 @@ from capt_env.wrappers.stacked_parts import kth_handle_from_bottom
 _MIN_HANDLE_POINTS = 3  # of the model's input cloud: fewer are noise, not a handle
 
 
+def handle_search_points(points: np.ndarray, dense_points: np.ndarray | None) -> tuple[np.ndarray, int]:
+    """(points to look for handles among, the fewest points of a handle): ``dense_points`` (K, 3)
+    when given and denser than ``points`` (M, 3), with the minimum scaled by K / M so a handle is the
+    same share of the cloud (3 of the model's input), else ``points`` and 3."""
+    if dense_points is None or len(dense_points) <= len(points):
+        return points, _MIN_HANDLE_POINTS
+    dense = np.asarray(dense_points, dtype=np.float64)
+    return dense, max(_MIN_HANDLE_POINTS, round(_MIN_HANDLE_POINTS * len(dense) / len(points)))
+
+
 class PerceptionSource(Protocol):
     """Anything that estimates the target joint. ``needs_points``: whether it reads the cloud."""
 
@@ -180,10 +190,7 @@ class CaptSource:
                  dense_points: np.ndarray | None = None) -> JointAxisEstimate:
         if points is None:
             raise ValueError("the capt source needs the object's points")
-        geometry, min_points = points, _MIN_HANDLE_POINTS
-        if self.dense_geometry and dense_points is not None and len(dense_points) > len(points):
-            geometry = np.asarray(dense_points, dtype=np.float64)
-            min_points = max(_MIN_HANDLE_POINTS, round(_MIN_HANDLE_POINTS * len(geometry) / len(points)))
+        geometry, min_points = handle_search_points(points, dense_points if self.dense_geometry else None)
         est = self._load()
         result = est.predict(np.asarray(points, dtype=np.float64))
         k = min(_target(info), len(result.joints) - 1)

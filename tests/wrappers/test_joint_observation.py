@@ -210,3 +210,30 @@ def test_hinge_on_edge_moves_a_far_off_line_onto_the_door_edge_away_from_the_han
     u, pivot = hinge_on_edge(np.array([0.0, 0.0, 1.0]), grasp, plane, bar, pivot=given_pivot)
     np.testing.assert_allclose(u, [0.0, 0.0, 1.0])
     np.testing.assert_allclose(pivot, [0.05, -0.1, 0.35], atol=1e-9)
+
+
+def test_a_handle_a_sparse_draw_loses_is_found_among_all_points() -> None:
+    """A dense cloud (16x the model's input) with a small knob (64 points, 4 expected in a 1/16 draw,
+    2 in this unlucky one): the draw alone has too few handle points; all points, with the minimum
+    scaled 16x, find the knob."""
+    from capt_env.wrappers.perception_sources import handle_search_points
+
+    rng = np.random.default_rng(3)
+    door = np.stack([np.zeros(8000), rng.uniform(-0.2, 0.2, 8000), rng.uniform(0.0, 0.4, 8000)], axis=1)
+    body = np.stack([rng.uniform(0.02, 0.4, 8000), rng.uniform(-0.2, 0.2, 8000), np.full(8000, 0.45)],
+                    axis=1)
+    knob = np.stack([rng.uniform(-0.04, -0.03, 64), rng.uniform(0.14, 0.15, 64), rng.uniform(0.2, 0.21, 64)],
+                    axis=1)
+    dense = np.concatenate([door, body, knob])
+    draw = np.concatenate([door[::16], body[::16], knob[:2]])
+    geometry, min_points = handle_search_points(draw, None)
+    assert geometry is draw and min_points == 3
+    assert handle_point(geometry, door[::16], min_points=min_points) is None
+    geometry, min_points = handle_search_points(draw, dense)
+    assert len(geometry) == len(dense) and min_points == round(3 * len(dense) / len(draw))
+    h = handle_point(geometry, door[::16], min_points=min_points)
+    assert h is not None
+    np.testing.assert_allclose(h, [-0.035, 0.145, 0.205], atol=0.01)
+    # scattered stray points standing off the door are fewer than the scaled minimum: no handle
+    stray = np.stack([np.full(20, -0.03), rng.uniform(-0.2, 0.2, 20), rng.uniform(0.0, 0.4, 20)], axis=1)
+    assert handle_point(np.concatenate([door, body, stray]), door[::16], min_points=min_points) is None
