@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from agents.scripted.config import ScriptedOpenerConfig
 from capt_env.registration import CATEGORY_ENV_NAMES, MAX_EPISODE_STEPS
 from capt_env.tasks.config import TaskConfig
 from capt_env.wrappers.config import PerceptionWrapperConfig
@@ -60,13 +61,17 @@ class PPOHyperparams:
 class ResidualConfig:
     """Residual PPO on the scripted opener (agents.ppo.residual): when ``enabled``, the executed
     action is the opener's plus ``scale`` times the policy's (clipped to [-1, 1]), and the policy
-    sees the opener's action and phase as well."""
+    sees the opener's action and phase as well. ``opener``: the scripted opener's config, in training
+    and wherever the trained policy runs (the run's ``config.yaml`` records it, so a shipped policy
+    keeps the opener it learned to correct when the opener's defaults change)."""
 
     enabled: bool = False
     scale: float = 0.2
+    opener: ScriptedOpenerConfig = field(default_factory=ScriptedOpenerConfig)
 
     def validate(self) -> None:
         require(0.0 < self.scale <= 2.0, f"residual.scale must be in (0, 2], got {self.scale}")
+        self.opener.validate()
 
 
 def _default_perception() -> PerceptionWrapperConfig:

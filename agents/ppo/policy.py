@@ -18,6 +18,8 @@ from stable_baselines3.common.vec_env import VecNormalize
 
 from agents.ppo.residual import RESIDUAL_OBSERVATION_SIZE, ResidualComposer
 from agents.ppo.train import CONFIG_FILE, vecnormalize_path
+from agents.scripted.config import ScriptedOpenerConfig
+from perception.yaml_config import from_dict
 
 CONSTANT_FEATURE_VAR = 1e-6
 """Training variance under which an observation feature counts as constant (see :class:`PPOPolicy`):
@@ -97,7 +99,9 @@ class PPOPolicy:
         run_config = run_config_of(path) or {}
         residual_cfg = run_config.get("residual") or {}
         if residual_cfg.get("enabled", False):
-            residual = ResidualComposer(float(residual_cfg.get("scale", 0.2)))
+            opener = from_dict(ScriptedOpenerConfig, residual_cfg.get("opener") or {},
+                               where=f"{path} run config residual.opener")
+            residual = ResidualComposer(float(residual_cfg.get("scale", 0.2)), opener)
         elif model.observation_space.shape == (RESIDUAL_OBSERVATION_SIZE,):
             raise ValueError(f"{path} is a residual PPO model but no run config.yaml with "
                              "'residual: {enabled: true, scale: ...}' lies beside it")

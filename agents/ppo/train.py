@@ -94,7 +94,7 @@ def make_train_env(config: PPOTrainConfig, rank: int) -> gym.Env:
     if config.residual.enabled:
         from agents.ppo.residual import ScriptedResidualWrapper
 
-        env = ScriptedResidualWrapper(env, config.residual.scale)
+        env = ScriptedResidualWrapper(env, config.residual.scale, config.residual.opener)
     if config.continue_after_success:
         env = ContinueAfterSuccess(env)
     return Monitor(env, info_keywords=("success",))

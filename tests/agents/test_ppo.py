@@ -15,6 +15,7 @@ import capt_env  # noqa: F401
 from agents.ppo.config import PPOTrainConfig
 from agents.ppo.policy import PPOPolicy
 from agents.ppo.train import ContinueAfterSuccess, latest_checkpoint, train_ppo
+from agents.scripted.config import ScriptedOpenerConfig
 from agents.scripted.rollout import make_env
 from perception.yaml_config import ConfigError, from_dict, load_yaml
 
@@ -26,6 +27,18 @@ TINY = {"category": "laptop", "perception": {"source": "noisy_oracle", "every_k_
 
 def tiny(**changes: object) -> PPOTrainConfig:
     return from_dict(PPOTrainConfig, {**TINY, **changes})
+
+
+def test_shipped_residual_policies_run_the_opener_they_were_trained_with() -> None:
+    """Both shipped residual policies were trained before the opener's hinge fit existed; their run
+    configs pin it off, and loading them gives their scripted opener that config."""
+    from agents.ppo.policy import PPOPolicy
+
+    for category in ("laptop", "drawer_cabinet"):
+        policy = PPOPolicy.load(ROOT / "agents" / "ppo" / "policies" / category / "final.zip")
+        assert policy.residual is not None
+        assert policy.residual.opener.cfg.arc_fit is False
+        assert policy.residual.opener.cfg.revolute_target == ScriptedOpenerConfig().revolute_target
 
 
 def test_shipped_configs_load() -> None:
@@ -53,6 +66,8 @@ def test_shipped_configs_load() -> None:
     ({"residual": {"enabled": True, "scale": 0.0}}, "residual.scale"),
     ({"residual": {"enable": True}}, "enable"),
     ({"ppo": {"log_std_init": 3.0}}, "log_std_init"),
+    ({"residual": {"enabled": True, "opener": {"arc_fit_min_angle": 0.0}}}, "arc_fit_min_angle"),
+    ({"residual": {"enabled": True, "opener": {"arcfit": False}}}, "arcfit"),
 ])
 def test_bad_config_values_are_rejected(changes: dict, match: str) -> None:
     with pytest.raises(ConfigError, match=match):
