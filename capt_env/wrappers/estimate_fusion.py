@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from capt_env.objects.geometry import rotate_about_axis
 from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, unit
 
 
@@ -98,10 +99,7 @@ def moved_with_part(point: np.ndarray, joint_type: str, direction: np.ndarray, l
     revolute) or slid ``delta`` m along ``direction`` (prismatic). World frame, metres."""
     if joint_type == "prismatic":
         return point + delta * direction
-    v = point - line_point
-    c, s = np.cos(delta), np.sin(delta)
-    turned = v * c + np.cross(direction, v) * s + direction * float(direction @ v) * (1.0 - c)
-    return line_point + turned
+    return rotate_about_axis(point[None], direction, line_point, delta)[0]
 
 
 def _trusted(entries: list[tuple[np.ndarray, float, bool]]) -> tuple[list[np.ndarray], list[float]]:
