@@ -50,6 +50,9 @@ class ScriptedOpenerConfig:
     at least ``limit_min_speed_m`` m per step, moves less than ``limit_slowdown`` of that speed for
     ``limit_window`` steps: the part has hit its end stop (pulled on, the handle would slide out of the
     fingers and a re-grasp would chase an open drawer). After release it backs off ``retreat_distance`` m.
+    With ``regrasp_other_fingers``, fingers that close on nothing (gap below ``hold_gap``; not a lid's)
+    open, back off and grasp again with the fingers the other way round (a re-grasp): for a low
+    handle one of the two finger orders can leave a wrist joint at its limit short of the handle.
     With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
     fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
     estimated hinge) from where the pull began, a circle is fitted to its path about the estimated
@@ -102,6 +105,7 @@ class ScriptedOpenerConfig:
     limit_window: int = 2
     limit_min_speed_m: float = 0.005
     max_regrasps: int = 2
+    regrasp_other_fingers: bool = True
     retreat_distance: float = 0.08
     release_steps: int = 6
     arc_fit: bool = True

@@ -71,6 +71,7 @@ ACTION_SCALE_M = 0.1  # pd_ee_delta_pose: metres per unit translation action
 # so a unit rotation action turns by -0.1 rad (XYZ Euler ~ rotation vector at these small angles).
 ACTION_SCALE_RAD = -0.1
 _UP = np.array([0.0, 0.0, 1.0])
+_SWAP_FINGERS = np.diag([-1.0, -1.0, 1.0])  # the same approach with the fingers the other way round
 # ManiSkill's Panda gripper maps action [-1, 1] linearly to each finger's position [-0.01, 0.04] m.
 _FINGER_LOW, _FINGER_HIGH = -0.01, 0.04
 
@@ -184,7 +185,7 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
 def nearer_finger_order(frame: np.ndarray, current: np.ndarray) -> np.ndarray:
     """Of TCP rotation ``frame`` (3, 3) and the same approach with the fingers swapped, the one
     nearer the current rotation ``current`` (3, 3)."""
-    flipped = frame @ np.diag([-1.0, -1.0, 1.0])
+    flipped = frame @ _SWAP_FINGERS
     if np.linalg.norm(rotation_error(flipped, current)) < np.linalg.norm(rotation_error(frame, current)):
         return flipped
     return frame
@@ -221,6 +222,7 @@ class ScriptedOpener:
         self._slip_count = 0
         self._retreat_from: np.ndarray | None = None
         self._grasp_again = False
+        self._other_fingers = False  # the next grasp turns the fingers the other way round
         self._still = 0
         self._last_p: np.ndarray | None = None
         self._last_err = (0.0, 0.0)
@@ -273,6 +275,9 @@ class ScriptedOpener:
         if self.phase in (Phase.PREGRASP, Phase.APPROACH):
             if self._target_r is None or self.phase == Phase.PREGRASP and self.phase_steps == 1:
                 self._target_r = grasp_rotation(est, r, cfg)
+                if self._other_fingers:
+                    self._target_r = self._target_r @ _SWAP_FINGERS
+                    self._other_fingers = False
                 self._lid = is_lid(est, cfg)
             lift = lift_pose(est, r, cfg, self.phase) if self._lift else None
             if lift is not None:
@@ -311,6 +316,14 @@ class ScriptedOpener:
                     # the fingers closed on nothing across the lid's lip (wider than the open
                     # fingers): back off, then lift the lid from below
                     self._lift = self._grasp_again = True
+                    self._set(Phase.RELEASE)
+                elif (not self._lid and cfg.regrasp_other_fingers and finger_gap is not None
+                        and finger_gap < cfg.hold_gap and self.regrasps < cfg.max_regrasps):
+                    # the fingers closed on nothing: the arm stopped short of the handle (a low handle
+                    # can put a wrist joint at its limit in one of the two finger orders); back off
+                    # and grasp again with the fingers the other way round
+                    self.regrasps += 1
+                    self._grasp_again = self._other_fingers = True
                     self._set(Phase.RELEASE)
                 else:
                     self._start_pull(p, r, est)

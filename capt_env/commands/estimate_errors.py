@@ -30,6 +30,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dense-geometry", default="on", choices=["both", "on", "off"],
                         help="look for handles among all isolated points (on), only CAPT's "
                              "downsampled input (off), or score both")
+    parser.add_argument("--slide-along-front", default="on", choices=["both", "on", "off"],
+                        help="slide a prismatic estimate along its part's front normal (on), keep "
+                             "CAPT's direction (off), or score both")
     add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
 
@@ -79,22 +82,23 @@ def run(args: argparse.Namespace) -> int:
     if args.resets < 1:
         raise SystemExit(f"--resets must be >= 1, got {args.resets}")
     choices = {"both": [False, True], "on": [True], "off": [False]}
-    flags = [(hinge, dense) for hinge in choices[args.hinge_on_part_edge]
-             for dense in choices[args.dense_geometry]]
+    flags = [(hinge, dense, front) for hinge in choices[args.hinge_on_part_edge]
+             for dense in choices[args.dense_geometry] for front in choices[args.slide_along_front]]
     seeds = list(range(args.first_seed, args.first_seed + args.resets))
     task = task_overrides(args.task)
-    header = ("| category | hinge on part edge | dense geometry | direction (deg) | sign right | "
-              "line (cm, mean) | line (cm, median) | grasp point (cm) | grasp > 10 cm | resets |")
-    table, results = [header, "|" + " --- |" * 10], []
+    header = ("| category | hinge on part edge | dense geometry | slide along front | direction (deg) | "
+              "sign right | line (cm, mean) | line (cm, median) | grasp point (cm) | grasp > 10 cm | "
+              "resets |")
+    table, results = [header, "|" + " --- |" * 11], []
     for category in args.categories:
-        for flag, dense in flags:
+        for flag, dense, front in flags:
             wrapper = {"source": "capt", "every_k_steps": 1, "hinge_on_part_edge": flag,
-                       "dense_geometry": dense,
+                       "dense_geometry": dense, "slide_along_front": front,
                        "checkpoint": str(args.checkpoint or default_checkpoint(category))}
             env = make_env(category, wrapper, task=task, obs_mode="pointcloud")
             rows = []
             try:
-                desc = f"{category} hinge-on-edge {_on(flag)} dense {_on(dense)}"
+                desc = f"{category} hinge-on-edge {_on(flag)} dense {_on(dense)} front {_on(front)}"
                 for seed in tqdm(seeds, desc=desc, leave=False):
                     _, info = env.reset(seed=seed)
                     rows.append({"seed": seed, **estimate_errors(env.estimate, ground_truth_estimate(info))})
@@ -102,8 +106,9 @@ def run(args: argparse.Namespace) -> int:
                 env.close()
             s = _summary(rows)
             results.append({"category": category, "hinge_on_part_edge": flag, "dense_geometry": dense,
+                            "slide_along_front": front,
                             **s, "per_reset": rows})
-            table.append(f"| {category.replace('_', ' ')} | {_on(flag)} | {_on(dense)} | "
+            table.append(f"| {category.replace('_', ' ')} | {_on(flag)} | {_on(dense)} | {_on(front)} | "
                          f"{s['direction_deg_mean']:.1f} | {s['sign_right']:.2f} | {_cm(s['line_m_mean'])} | "
                          f"{_cm(s['line_m_median'])} | {100 * s['grasp_m_mean']:.1f} | "
                          f"{s['grasp_far']:.2f} | {s['resets']} |")

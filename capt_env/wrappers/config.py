@@ -88,7 +88,10 @@ class PerceptionWrapperConfig:
     of the part CAPT labels with the target's index (it often gives a drawer its neighbour's label);
     with fewer handles in view, CAPT's label decides. ``dense_geometry`` (``capt`` only): look for
     handles among all isolated object points rather than the ``num_points`` fed to CAPT (a handle is
-    a few of those, kept by one draw and lost by the next).
+    a few of those, kept by one draw and lost by the next). ``slide_along_front`` (``capt`` only): a
+    prismatic estimate slides along the normal of its part's flat front (a plane fitted to hundreds
+    of points) when that front faces within 0.6 rad of CAPT's direction; off, the direction is
+    CAPT's own, only its sign set by the front.
     """
 
     source: Source = "oracle"
@@ -102,6 +105,7 @@ class PerceptionWrapperConfig:
     hinge_on_part_edge: bool = True
     order_stacked_parts: bool = True
     dense_geometry: bool = True
+    slide_along_front: bool = True
 
     def validate(self) -> None:
         require(self.every_k_steps >= 1, f"every_k_steps must be >= 1, got {self.every_k_steps}")

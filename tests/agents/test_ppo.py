@@ -30,14 +30,16 @@ def tiny(**changes: object) -> PPOTrainConfig:
 
 
 def test_shipped_residual_policies_run_the_opener_they_were_trained_with() -> None:
-    """Both shipped residual policies were trained before the opener's hinge fit existed; their run
-    configs pin it off, and loading them gives their scripted opener that config."""
+    """Both shipped residual policies were trained before the opener's hinge fit and its re-grasp
+    with the fingers swapped existed; their run configs pin both off, and loading them gives their
+    scripted opener that config."""
     from agents.ppo.policy import PPOPolicy
 
     for category in ("laptop", "drawer_cabinet"):
         policy = PPOPolicy.load(ROOT / "agents" / "ppo" / "policies" / category / "final.zip")
         assert policy.residual is not None
         assert policy.residual.opener.cfg.arc_fit is False
+        assert policy.residual.opener.cfg.regrasp_other_fingers is False
         assert policy.residual.opener.cfg.revolute_target == ScriptedOpenerConfig().revolute_target
 
 

@@ -71,6 +71,50 @@ def test_a_lip_the_fingers_closed_on_nothing_is_lifted_from_below() -> None:
     assert opener.phase == Phase.PULL and not opener._lift
 
 
+def _closed_drawer() -> JointAxisEstimate:
+    # a drawer sliding out along -x, its handle at (0.1, 0, 0.1)
+    return JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.zeros(3), 0.0,
+                             np.array([0.1, 0.0, 0.1]))
+
+
+def _pose(rotation: np.ndarray, position: np.ndarray) -> np.ndarray:
+    quat = Rotation.from_matrix(rotation).as_quat(scalar_first=True)
+    return np.concatenate([position, quat])
+
+
+def test_fingers_that_closed_on_nothing_grasp_again_the_other_way_round() -> None:
+    cfg = ScriptedOpenerConfig()
+    est = _closed_drawer()
+    opener = ScriptedOpener(cfg)
+    start = grasp_rotation(est, np.eye(3), cfg)
+    at_handle = _pose(start, est.grasp_point)
+    opener.act_on(est, at_handle)
+    assert opener._target_r is not None
+    np.testing.assert_allclose(opener._target_r, start, atol=1e-9)  # the nearer order: the one it has
+    opener._set(Phase.CLOSE)
+    for _ in range(cfg.close_steps):
+        opener.act_on(est, at_handle, finger_gap=0.0)
+    assert opener.phase == Phase.RELEASE and opener.regrasps == 1
+    for _ in range(cfg.release_steps):
+        opener.act_on(est, at_handle)
+    assert opener.phase == Phase.RETREAT
+    backed_off = _pose(start, est.grasp_point - start[:, 2] * cfg.retreat_distance)
+    opener.act_on(est, backed_off)
+    assert opener.phase == Phase.PREGRASP
+    opener.act_on(est, backed_off)
+    # same approach, fingers swapped: half a turn about the approach axis from where the hand is
+    np.testing.assert_allclose(opener._target_r[:, 2], start[:, 2], atol=1e-9)
+    np.testing.assert_allclose(opener._target_r[:, 1], -start[:, 1], atol=1e-9)
+    # fingers that closed on the handle (a gap) pull; with the option off, a miss pulls too
+    for gap, other_fingers, phase in ((0.02, True, Phase.PULL), (0.0, False, Phase.PULL)):
+        opener = ScriptedOpener(ScriptedOpenerConfig(regrasp_other_fingers=other_fingers))
+        opener.act_on(est, at_handle)
+        opener._set(Phase.CLOSE)
+        for _ in range(cfg.close_steps):
+            opener.act_on(est, at_handle, finger_gap=gap)
+        assert opener.phase == phase and opener.regrasps == 0
+
+
 def test_doors_and_drawers_are_not_lids() -> None:
     cfg = ScriptedOpenerConfig()
     door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]), 0.0,

@@ -1,0 +1,56 @@
+"""CaptSource's geometry on a constructed drawer cloud, with a stand-in for the network."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from capt_env.wrappers.perception_sources import CaptSource
+from perception.inference import ArticulationEstimate, JointEstimate
+
+
+def _drawer_cloud(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A cabinet seen from the front (-x): its top (label 0) and a drawer front in the plane
+    x = -0.2 facing -x (label 1) with a bar handle 3 cm out at (-0.23, 0, 0.3) (label 1). World
+    frame, metres. Returns (points (N, 3), part labels (N,))."""
+    top = np.column_stack([rng.uniform(-0.2, 0.2, 400), rng.uniform(-0.25, 0.25, 400), np.full(400, 0.5)])
+    front = np.column_stack([np.full(500, -0.2), rng.uniform(-0.2, 0.2, 500), rng.uniform(0.2, 0.4, 500)])
+    handle = np.column_stack([np.full(40, -0.23), rng.uniform(-0.05, 0.05, 40), np.full(40, 0.3)])
+    points = np.concatenate([top, front, handle]) + rng.normal(0.0, 0.001, (940, 3))
+    return points, np.concatenate([np.zeros(400, int), np.ones(540, int)])
+
+
+class _Network:
+    """Stands in for ``ArticulationEstimator``: the given labels and one prismatic joint whose
+    direction is 10 degrees off the drawer's slide (-x), tilted upwards."""
+
+    def __init__(self, labels: np.ndarray) -> None:
+        self.labels = labels
+        model = SimpleNamespace(joint_child_parts=(1,), joint_types=("prismatic",))
+        self.config = SimpleNamespace(model=model)
+
+    def predict(self, points: np.ndarray) -> ArticulationEstimate:
+        tilt = np.radians(10.0)
+        joint = JointEstimate(0, "prismatic", np.array([-np.cos(tilt), 0.0, np.sin(tilt)]),
+                              np.array([-0.2, 0.0, 0.3]), 0.0, 0.9)
+        return ArticulationEstimate(self.labels, (joint,), 1.0)
+
+
+def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.degrees(np.arccos(np.clip(a @ b / np.linalg.norm(a) / np.linalg.norm(b), -1.0, 1.0))))
+
+
+@pytest.mark.parametrize("slide_along_front, max_error_deg, min_error_deg", [(True, 0.5, 0.0),
+                                                                              (False, 10.5, 9.5)])
+def test_a_drawer_slides_along_its_front_normal(slide_along_front: bool, max_error_deg: float,
+                                                min_error_deg: float) -> None:
+    points, labels = _drawer_cloud(np.random.default_rng(0))
+    source = CaptSource("unused.pt", slide_along_front=slide_along_front)
+    source._estimator = _Network(labels)
+    est = source.estimate(points, {"target_joint": np.array([0])})
+    error = _angle_deg(est.direction, np.array([-1.0, 0.0, 0.0]))
+    assert min_error_deg <= error <= max_error_deg
+    assert est.joint_type == "prismatic"
+    np.testing.assert_allclose(est.grasp_point, [-0.23, 0.0, 0.3], atol=0.01)  # the handle
