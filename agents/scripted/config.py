@@ -20,12 +20,14 @@ class ScriptedOpenerConfig:
     turns in place to the grasp orientation while it is more than ``rotate_first_above`` rad from it, for
     at most ``rotate_first_steps`` steps (turned while travelling, the arm's IK reaches a low, far handle
     with the wrist at its joint limit and cannot hold the pose while pulling; 0 steps: never). The fingers
-    approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched fingertip
-    off the surface a handle stands on). Moves are capped at ``max_step_m`` / ``max_step_rad`` per control
-    step; ``pos_tolerance`` / ``rot_tolerance`` end a move, as do ``move_timeout`` steps or
-    ``blocked_steps`` steps without TCP motion (contact). A lid (a revolute part whose grasp point opens
-    within ``lid_max_tilt`` rad of straight up, like a closed laptop) is gripped from above with the
-    fingers ``lid_approach_gap`` m apart and closing along the hinge, across its front lip,
+    approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched
+    fingertip off the surface a handle stands on, but under 6 cm a finger pitched across a drawer's bar
+    clips its edge when the grasp point is half a centimetre off). Moves are capped at ``max_step_m`` /
+    ``max_step_rad`` per control step; ``pos_tolerance`` / ``rot_tolerance`` end a move, as do
+    ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact). A lid (a revolute
+    part whose grasp point opens within ``lid_max_tilt`` rad of straight up, like a closed laptop) is
+    gripped from above with the fingers ``lid_approach_gap`` m apart and closing along the hinge,
+    across its front lip,
     ``lid_edge_offset`` m beyond the grasp point away from the hinge (so the pads clear the lid's edge
     whether the grasp point is the lip's centre, as with ground truth, or the outer band of its points, as
     from CAPT); the hand turns by ``lid_wrist_follow`` of the lid's angle (the pinch lets the lip turn
@@ -77,7 +79,7 @@ class ScriptedOpenerConfig:
     rot_tolerance: float = 0.12
     move_timeout: int = 60
     blocked_steps: int = 6
-    approach_gap: float = 0.045
+    approach_gap: float = 0.06
     lid_max_tilt: float = 0.5
     lid_approach_gap: float = 0.08
     lid_edge_offset: float = 0.005

@@ -74,7 +74,7 @@ def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standof
     keep &= standoff >= 0.5 * float(np.quantile(standoff[keep], 0.9))
     if int(keep.sum()) < min_points:
         return None
-    return bar_centre(object_points[keep])
+    return bar_centre(object_points[keep], plane.outward)
 
 
 def standing_off(points: np.ndarray, plane: PartPlane, lo: np.ndarray, hi: np.ndarray,
@@ -87,15 +87,25 @@ def standing_off(points: np.ndarray, plane: PartPlane, lo: np.ndarray, hi: np.nd
             & np.all(uv >= lo, axis=1) & np.all(uv <= hi, axis=1))
 
 
-def bar_centre(handle: np.ndarray) -> np.ndarray:
+def bar_centre(handle: np.ndarray, outward: np.ndarray | None = None) -> np.ndarray:
     """Centre (3,) of a handle's points (M, 3): their centroid moved, along their main direction, to
-    the middle of their extent (the visible points of a bar are denser at one end)."""
+    the middle of their extent (the visible points of a bar are denser at one end). Given the unit
+    normal ``outward`` (3,) of the face the handle stands on, it is also moved to the middle of their
+    extent across the bar in that face's plane: a camera sees one side of a bar and its front, so the
+    centroid sits on the seen side (a drawer's bar seen from above: half its thickness high)."""
     centre = handle.mean(axis=0)
     if len(handle) < 2:
         return centre
     along = np.linalg.svd(handle - centre, full_matrices=False)[2][0]
-    t = np.quantile((handle - centre) @ along, [0.05, 0.95])
-    return centre + along * float(t.mean())
+    directions = [along]
+    if outward is not None:
+        across = np.cross(along, outward)
+        if np.linalg.norm(across) > 0.5:  # the bar lies in the face's plane, not along its normal
+            directions.append(across / np.linalg.norm(across))
+    for d, q in zip(directions, (0.05, 0.01), strict=False):
+        t = np.quantile((handle - centre) @ d, [q, 1.0 - q])
+        centre = centre + d * float(t.mean())
+    return centre
 
 
 def opening_direction(joint_type: str, direction: np.ndarray, pivot: np.ndarray, grasp: np.ndarray,

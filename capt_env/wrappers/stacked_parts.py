@@ -55,10 +55,14 @@ def kth_handle_from_bottom(object_points: np.ndarray, front_points: np.ndarray, 
     """Centre (3,) of the ``k``-th handle from the bottom on a stack's front (see
     :func:`handle_groups`), world frame, metres; None when fewer than ``k + 1`` handles are seen.
     The centre is the middle of the handle's extent along its main direction (a bar's visible
-    points are denser at one end). ``min_points``: the fewest points of a handle."""
+    points are denser at one end) and across it in the front's plane (a camera sees one side of a
+    bar). ``min_points``: the fewest points of a handle."""
     if k < 0:
         raise ValueError(f"k must be >= 0, got {k}")
+    plane = plane or part_plane(object_points, front_points)
+    if plane is None:
+        return None
     groups = handle_groups(object_points, front_points, plane=plane, min_points=min_points)
     if len(groups) <= k:
         return None
-    return bar_centre(groups[k])
+    return bar_centre(groups[k], plane.outward)

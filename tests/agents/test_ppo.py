@@ -30,9 +30,9 @@ def tiny(**changes: object) -> PPOTrainConfig:
 
 
 def test_shipped_residual_policies_run_the_opener_they_were_trained_with() -> None:
-    """Both shipped residual policies were trained before the opener's hinge fit and its re-grasp
-    with the fingers swapped existed; their run configs pin both off, and loading them gives their
-    scripted opener that config."""
+    """Both shipped residual policies were trained before the opener's hinge fit, its re-grasp
+    with the fingers swapped and its wider approach gap; their run configs pin the old behaviour,
+    and loading them gives their scripted opener that config."""
     from agents.ppo.policy import PPOPolicy
 
     for category in ("laptop", "drawer_cabinet"):
@@ -40,6 +40,7 @@ def test_shipped_residual_policies_run_the_opener_they_were_trained_with() -> No
         assert policy.residual is not None
         assert policy.residual.opener.cfg.arc_fit is False
         assert policy.residual.opener.cfg.regrasp_other_fingers is False
+        assert policy.residual.opener.cfg.approach_gap == pytest.approx(0.045)
         assert policy.residual.opener.cfg.revolute_target == ScriptedOpenerConfig().revolute_target
 
 

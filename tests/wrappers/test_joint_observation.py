@@ -15,6 +15,7 @@ from capt_env.wrappers.joint_observation import (
     observation_layout,
 )
 from capt_env.wrappers.moving_part_geometry import (
+    bar_centre,
     edge_aligned_direction,
     handle_point,
     hinge_on_edge,
@@ -118,6 +119,18 @@ def test_handle_point_survives_mislabelled_body_points_surface_noise_and_uneven_
     h = handle_point(cloud, part)
     assert h is not None
     np.testing.assert_allclose(h, [-0.03, 0.0, 0.35], atol=0.02)
+
+
+def test_bar_centre_of_a_bar_seen_from_above_is_the_middle_of_its_thickness() -> None:
+    # a 2 cm square bar along y, centred at (-0.03, 0, 0.35) in front of a face whose outward normal is
+    # -x, seen from above and in front: its top (z = 0.36, dense) and front (x = -0.04) faces only
+    rng = np.random.default_rng(4)
+    top = np.stack([rng.uniform(-0.04, -0.02, 300), rng.uniform(-0.1, 0.1, 300), np.full(300, 0.36)], axis=1)
+    front = np.stack([np.full(100, -0.04), rng.uniform(-0.1, 0.1, 100), rng.uniform(0.34, 0.36, 100)], axis=1)
+    bar = np.concatenate([top, front])
+    centre = bar_centre(bar, np.array([-1.0, 0.0, 0.0]))
+    np.testing.assert_allclose(centre[1:], [0.0, 0.35], atol=0.002)  # across the bar: its middle
+    assert bar_centre(bar)[2] > 0.354  # the centroid sits on the seen top side
 
 
 def test_opening_direction_turns_the_axis_so_the_part_moves_away_from_its_body() -> None:
