@@ -49,7 +49,7 @@ def part_plane(object_points: np.ndarray, part_points: np.ndarray) -> PartPlane 
 
 def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standoff: float = 0.012,
                  max_standoff: float = 0.08, margin: float = 0.1, min_points: int = 3,
-                 plane: PartPlane | None = None) -> np.ndarray | None:
+                 plane: PartPlane | None = None, centre_across: bool = False) -> np.ndarray | None:
     """Centre (3,) of a handle standing off a flat moving part, or None; world frame, metres.
 
     The part's plane is ``plane`` when the caller has it, else ``part_plane(object_points,
@@ -59,7 +59,8 @@ def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standof
     in-plane extent grown by ``margin`` m (a view may show only some of the part), keeping those
     standing at least half as far out as the outermost ones (a bar, not the part's own surface
     noise); the point returned is their centroid moved, along their main direction, to the middle
-    of their extent. None when the part is not flat or fewer than ``min_points`` qualify.
+    of their extent (with ``centre_across`` also across the bar in the part's plane, see
+    :func:`bar_centre`). None when the part is not flat or fewer than ``min_points`` qualify.
     """
     plane = plane or part_plane(object_points, part_points)
     if plane is None or len(object_points) < min_points:
@@ -74,7 +75,7 @@ def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standof
     keep &= standoff >= 0.5 * float(np.quantile(standoff[keep], 0.9))
     if int(keep.sum()) < min_points:
         return None
-    return bar_centre(object_points[keep], plane.outward)
+    return bar_centre(object_points[keep], plane.outward if centre_across else None)
 
 
 def standing_off(points: np.ndarray, plane: PartPlane, lo: np.ndarray, hi: np.ndarray,

@@ -57,6 +57,10 @@ class PerceptionSource(Protocol):
         ...
 
 
+# a hinge within 60 degrees of vertical (a door's, a washing machine's) counts as vertical
+_VERTICAL_HINGE_MIN_Z = 0.5
+
+
 def faces_along(plane: PartPlane | None, direction: np.ndarray, max_angle: float = 0.6) -> bool:
     """Whether ``plane``'s normal is within ``max_angle`` rad of the line of ``direction`` (3,): a
     drawer's front faces along its slide. False for no plane."""
@@ -219,7 +223,12 @@ class CaptSource:
         if plane is not None and self.hinge_on_part_edge and joint.type == "revolute":
             direction = edge_aligned_direction(direction, plane, moving)
         if grasp is None and plane is not None:
-            grasp = handle_point(geometry, moving, plane=plane, min_points=min_points)
+            # a bar is centred across its thickness too (the cameras see one side of it, where the
+            # points' centroid sits), except on a part swinging about a horizontal hinge (an oven
+            # door, a lid): measured, that moved an oven's grasp point off its bar
+            across = joint.type == "prismatic" or abs(float(direction[2])) >= _VERTICAL_HINGE_MIN_Z
+            grasp = handle_point(geometry, moving, plane=plane, min_points=min_points,
+                                 centre_across=across)
         from_handle = grasp is not None
         if plane is not None and joint.type == "prismatic":
             # before the grasp point: the front-most points along a wrongly signed slide are the back
