@@ -20,18 +20,17 @@ class ScriptedOpenerConfig:
     turns in place to the grasp orientation while it is more than ``rotate_first_above`` rad from it, for
     at most ``rotate_first_steps`` steps (turned while travelling, the arm's IK reaches a low, far handle
     with the wrist at its joint limit and cannot hold the pose while pulling; 0 steps: never). The fingers
-    approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched
-    fingertip off the surface a handle stands on, but under 6 cm a finger pitched across a drawer's bar
-    clips its edge when the grasp point is half a centimetre off). Moves are capped at ``max_step_m`` /
+    approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched fingertip
+    off the surface a handle stands on, but under 6 cm a finger pitched across a drawer's bar clips its
+    edge when the grasp point is half a centimetre off). Moves are capped at ``max_step_m`` /
     ``max_step_rad`` per control step; ``pos_tolerance`` / ``rot_tolerance`` end a move, as do
-    ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact). A lid (a revolute
-    part whose grasp point opens within ``lid_max_tilt`` rad of straight up, like a closed laptop) is
-    gripped from above with the fingers ``lid_approach_gap`` m apart and closing along the hinge,
-    across its front lip,
-    ``lid_edge_offset`` m beyond the grasp point away from the hinge (so the pads clear the lid's edge
-    whether the grasp point is the lip's centre, as with ground truth, or the outer band of its points, as
-    from CAPT); the hand turns by ``lid_wrist_follow`` of the lid's angle (the pinch lets the lip turn
-    between the pads; a hand turned with the lid would point back at the robot), and pulls to
+    ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact). A lid (a revolute part
+    whose grasp point opens within ``lid_max_tilt`` rad of straight up, like a closed laptop) is gripped
+    from above with the fingers ``lid_approach_gap`` m apart and closing along the hinge, across its front
+    lip, ``lid_edge_offset`` m beyond the grasp point away from the hinge (so the pads clear the lid's
+    edge whether the grasp point is the lip's centre, as with ground truth, or the outer band of its
+    points, as from CAPT); the hand turns by ``lid_wrist_follow`` of the lid's angle (the pinch lets the
+    lip turn between the pads; a hand turned with the lid would point back at the robot), and pulls to
     ``lid_revolute_target`` rad (past upright, so the lid does not rest on its hinge's friction just short
     of the success angle). If the fingers close on nothing across a lid's lip (it is wider than the open
     fingers), the hand backs off and lifts the lid from below (``lid_lift``): fingers closed, pointing at
@@ -53,17 +52,16 @@ class ScriptedOpenerConfig:
     ``limit_window`` steps: the part has hit its end stop (pulled on, the handle would slide out of the
     fingers and a re-grasp would chase an open drawer). After release it backs off ``retreat_distance`` m.
     With ``regrasp_other_fingers``, fingers that close on nothing (gap below ``hold_gap``; not a lid's)
-    open, back off and grasp again with the fingers the other way round (a re-grasp): for a low
-    handle one of the two finger orders can leave a wrist joint at its limit short of the handle.
-    With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
-    fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
-    estimated hinge) from where the pull began, a circle is fitted to its path about the estimated
-    axis direction; if the path lies within ``arc_fit_max_rms`` m
-    of that circle and its centre is within ``arc_fit_max_shift`` m of the estimated line, the centre
-    replaces the estimated pivot for the rest of this pull (the swept angle and the arc the hand
-    follows; the first accepted fit is kept, as a hand slipping off the handle later leaves the arc). A
-    pivot a few cm off the hinge of a 20 cm door reads the swept angle 0.4 rad too large, and the
-    hand lets go short of open.
+    open, back off and grasp again with the fingers the other way round (a re-grasp): for a low handle one
+    of the two finger orders can leave a wrist joint at its limit short of the handle. With ``arc_fit``, a
+    hinge is also measured by the hand that holds its part: once the TCP, with the fingers apart
+    (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the estimated hinge)
+    from where the pull began, a circle is fitted to its path about the estimated axis direction; if the
+    path lies within ``arc_fit_max_rms`` m of that circle and its centre is within ``arc_fit_max_shift`` m
+    of the estimated line, the centre replaces the estimated pivot for the rest of this pull (the swept
+    angle and the arc the hand follows; the first accepted fit is kept, as a hand slipping off the handle
+    later leaves the arc). A pivot a few cm off the hinge of a 20 cm door reads the swept angle 0.4 rad
+    too large, and the hand lets go short of open.
     """
 
     pregrasp_offset: float = 0.08

@@ -98,13 +98,15 @@ def bar_centre(handle: np.ndarray, outward: np.ndarray | None = None) -> np.ndar
     if len(handle) < 2:
         return centre
     along = np.linalg.svd(handle - centre, full_matrices=False)[2][0]
-    directions = [along]
+    # (direction, share of points trimmed at each end of the extent): along a bar its ends are
+    # sparse; across it the extent is the bar's thickness and every point counts
+    extents = [(along, 0.05)]
     if outward is not None:
         across = np.cross(along, outward)
         if np.linalg.norm(across) > 0.5:  # the bar lies in the face's plane, not along its normal
-            directions.append(across / np.linalg.norm(across))
-    for d, q in zip(directions, (0.05, 0.01), strict=False):
-        t = np.quantile((handle - centre) @ d, [q, 1.0 - q])
+            extents.append((across / np.linalg.norm(across), 0.01))
+    for d, trim in extents:
+        t = np.quantile((handle - centre) @ d, [trim, 1.0 - trim])
         centre = centre + d * float(t.mean())
     return centre
 

@@ -233,10 +233,11 @@ class CaptSource:
         if plane is not None and joint.type == "prismatic":
             # before the grasp point: the front-most points along a wrongly signed slide are the back
             # (a prismatic opening direction does not depend on the pivot or grasp point)
-            pivot_in = np.asarray(joint.pivot, dtype=np.float64)
-            direction = opening_direction(joint.type, direction, pivot_in, pivot_in, plane.outward)
             if self.slide_along_front:
                 direction = unit(plane.outward)
+            else:
+                pivot_in = np.asarray(joint.pivot, dtype=np.float64)
+                direction = opening_direction(joint.type, direction, pivot_in, pivot_in, plane.outward)
         if grasp is None:
             grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
