@@ -37,31 +37,36 @@ class ScriptedOpenerConfig:
     the hinge ``lid_lift_pitch`` rad below horizontal, the fingertips go ``lid_lift_below`` m under the
     grasp point, from ``lid_lift_front`` m in front of it to ``lid_lift_under`` m behind it, and push the
     lid open along the same arc as a pull, the hand turning by ``lid_lift_wrist_follow`` of the lid's
-    angle. ``close_steps`` steps close the gripper. Pulling leads the part by ``revolute_lead`` rad or
-    ``prismatic_lead`` m. The hand turns with a door about a vertical hinge, and by ``wrist_follow`` of
-    the part's angle about any other hinge (a grasped bar turns between the pads; a hand turned fully with
-    an oven door reaches the Panda's wrist limit). Pulling stops at ``revolute_target`` rad /
-    ``prismatic_target`` m, or when the state grew by less than ``stall_progress`` rad /
-    ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost grip). The gripper re-grasps (at
-    most ``max_regrasps`` times) if it stays more than ``slip_distance`` m from the part's perceived grasp
-    point for ``slip_steps`` steps (longer than the perception period, so one bad estimate, e.g. of a
-    handle the hand now hides, is not a slip) and its fingers are less than ``hold_gap`` m apart (closed
-    on nothing; a gap means they hold the handle, whatever the perceived grasp point says). Pulling a
-    prismatic part ends for good, without a re-grasp, when the hand, having pulled at a cruising speed of
-    at least ``limit_min_speed_m`` m per step, moves less than ``limit_slowdown`` of that speed for
-    ``limit_window`` steps: the part has hit its end stop (pulled on, the handle would slide out of the
-    fingers and a re-grasp would chase an open drawer). After release it backs off ``retreat_distance`` m.
-    With ``regrasp_other_fingers``, fingers that close on nothing (gap below ``hold_gap``; not a lid's)
-    open, back off and grasp again with the fingers the other way round (a re-grasp): for a low handle one
-    of the two finger orders can leave a wrist joint at its limit short of the handle. With ``arc_fit``, a
-    hinge is also measured by the hand that holds its part: once the TCP, with the fingers apart
-    (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the estimated hinge)
-    from where the pull began, a circle is fitted to its path about the estimated axis direction; if the
-    path lies within ``arc_fit_max_rms`` m of that circle and its centre is within ``arc_fit_max_shift`` m
-    of the estimated line, the centre replaces the estimated pivot for the rest of this pull (the swept
-    angle and the arc the hand follows; the first accepted fit is kept, as a hand slipping off the handle
-    later leaves the arc). A pivot a few cm off the hinge of a 20 cm door reads the swept angle 0.4 rad
-    too large, and the hand lets go short of open.
+    angle and moving ``lid_lift_inward`` m towards the hinge per radian the lid has turned (on an
+    estimated hinge 1-2 cm off, the fingertips following its arc slid off the lip at about 1.2 rad;
+    sliding towards the hinge they stay under the lid). ``close_steps`` steps close the gripper. Pulling
+    leads the part by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a door about a
+    vertical hinge, and by ``wrist_follow`` of the part's angle about any other hinge (a grasped bar turns
+    between the pads; a hand turned fully with an oven door reaches the Panda's wrist limit). Pulling
+    stops at ``revolute_target`` rad / ``prismatic_target`` m, or when the state grew by less than
+    ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost grip).
+    The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than ``slip_distance`` m from
+    the part's perceived grasp point for ``slip_steps`` steps (longer than the perception period, so one
+    bad estimate, e.g. of a handle the hand now hides, is not a slip) and its fingers are less than
+    ``hold_gap`` m apart (closed on nothing; a gap means they hold the handle, whatever the perceived
+    grasp point says). Pulling a prismatic part ends for good, without a re-grasp, when the hand, having
+    pulled at a cruising speed of at least ``limit_min_speed_m`` m per step, moves less than
+    ``limit_slowdown`` of that speed for ``limit_window`` steps: the part has hit its end stop (pulled on,
+    the handle would slide out of the fingers and a re-grasp would chase an open drawer). After release it
+    backs off ``retreat_distance`` m. With ``regrasp_other_fingers``, fingers that close on nothing (gap
+    below ``hold_gap``; not a lid's) open, back off and grasp again with the fingers the other way round
+    (a re-grasp): for a low handle one of the two finger orders can leave a wrist joint at its limit short
+    of the handle. A pull that stalls with one of the Panda's wrist joints (5, 6, 7) within
+    ``wrist_limit_margin`` rad of its limit (0: off) grasps again that way too: the arm ran out of range
+    with this finger order (oven doors), and grasping again the same way returns it to the same limit.
+    With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
+    fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
+    estimated hinge) from where the pull began, a circle is fitted to its path about the estimated axis
+    direction; if the path lies within ``arc_fit_max_rms`` m of that circle and its centre is within
+    ``arc_fit_max_shift`` m of the estimated line, the centre replaces the estimated pivot for the rest of
+    this pull (the swept angle and the arc the hand follows; the first accepted fit is kept, as a hand
+    slipping off the handle later leaves the arc). A pivot a few cm off the hinge of a 20 cm door reads
+    the swept angle 0.4 rad too large, and the hand lets go short of open.
     """
 
     pregrasp_offset: float = 0.08
@@ -89,6 +94,7 @@ class ScriptedOpenerConfig:
     lid_lift_front: float = 0.06
     lid_lift_under: float = 0.0
     lid_lift_wrist_follow: float = 0.0
+    lid_lift_inward: float = 0.02
     close_steps: int = 8
     revolute_lead: float = 0.12
     prismatic_lead: float = 0.03
@@ -106,6 +112,7 @@ class ScriptedOpenerConfig:
     limit_min_speed_m: float = 0.005
     max_regrasps: int = 2
     regrasp_other_fingers: bool = True
+    wrist_limit_margin: float = 0.05
     retreat_distance: float = 0.08
     release_steps: int = 6
     arc_fit: bool = True
@@ -138,11 +145,13 @@ class ScriptedOpenerConfig:
         require(self.lid_edge_offset >= 0, f"lid_edge_offset must be >= 0 m, got {self.lid_edge_offset}")
         require(0.0 < self.lid_lift_pitch <= 1.5,
                 f"lid_lift_pitch must be in (0, 1.5] rad, got {self.lid_lift_pitch}")
-        for key in ("lid_lift_below", "lid_lift_front", "lid_lift_under"):
+        for key in ("lid_lift_below", "lid_lift_front", "lid_lift_under", "lid_lift_inward"):
             require(getattr(self, key) >= 0, f"{key} must be >= 0 m, got {getattr(self, key)}")
         require(0.0 < self.limit_slowdown < 1.0,
                 f"limit_slowdown must be in (0, 1), got {self.limit_slowdown}")
         require(self.max_regrasps >= 0, "max_regrasps must be >= 0")
+        require(0.0 <= self.wrist_limit_margin < 0.5,
+                f"wrist_limit_margin must be in [0, 0.5) rad (0: off), got {self.wrist_limit_margin}")
         for key in ("approach_pitch", "vertical_hinge_pitch", "vertical_hinge_max_tilt", "lid_max_tilt"):
             value = getattr(self, key)
             require(0 <= value <= 1.5, f"{key} must be in [0, 1.5] rad, got {value}")

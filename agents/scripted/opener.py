@@ -72,6 +72,9 @@ ACTION_SCALE_M = 0.1  # pd_ee_delta_pose: metres per unit translation action
 ACTION_SCALE_RAD = -0.1
 _UP = np.array([0.0, 0.0, 1.0])
 _SWAP_FINGERS = np.diag([-1.0, -1.0, 1.0])  # the same approach with the fingers the other way round
+# the Panda's wrist joints 5, 6 and 7 (rad), from its URDF
+_WRIST_LOWER = np.array([-2.8973, -0.0175, -2.8973])
+_WRIST_UPPER = np.array([2.8973, 3.7525, 2.8973])
 # ManiSkill's Panda gripper maps action [-1, 1] linearly to each finger's position [-0.01, 0.04] m.
 _FINGER_LOW, _FINGER_HIGH = -0.01, 0.04
 
@@ -226,6 +229,7 @@ class ScriptedOpener:
         self._still = 0
         self._last_p: np.ndarray | None = None
         self._last_err = (0.0, 0.0)
+        self._arm_qpos: np.ndarray | None = None
 
     # --------------------------------------------------------------- helpers
     def _goto(self, p: np.ndarray, r: np.ndarray, p_des: np.ndarray, r_des: np.ndarray,
@@ -256,18 +260,21 @@ class ScriptedOpener:
         """Action (7,) in [-1, 1] for ``pd_ee_delta_pose`` from a joint-axis observation."""
         proprio, est = decode_observation(obs)
         qpos = np.asarray(proprio["qpos"], dtype=np.float64).reshape(-1)
-        return self.act_on(est, proprio["tcp_pose"], finger_gap=float(qpos[7] + qpos[8]))
+        return self.act_on(est, proprio["tcp_pose"], finger_gap=float(qpos[7] + qpos[8]),
+                           arm_qpos=qpos[:7])
 
     def act_on(self, est: JointAxisEstimate, tcp_pose: np.ndarray,
-               finger_gap: float | None = None) -> np.ndarray:
+               finger_gap: float | None = None, arm_qpos: np.ndarray | None = None) -> np.ndarray:
         """Action (7,) from an estimate and the TCP pose (7,) (position m, quaternion wxyz), world frame.
 
         ``finger_gap``: the distance between the Panda's fingers (m), when known. While pulling, a gap
         of at least ``hold_gap`` means the fingers still hold something, so the hand is not slipped
         whatever the perceived grasp point says (a part turned far from its first pose is often
-        segmented worse).
+        segmented worse). ``arm_qpos``: the arm's seven joint angles (rad), when known; a pull that
+        stalls with a wrist joint at its limit grasps again with the fingers the other way round.
         """
         cfg = self.cfg
+        self._arm_qpos = None if arm_qpos is None else np.asarray(arm_qpos, dtype=np.float64).reshape(-1)
         p = np.asarray(tcp_pose[:3], dtype=np.float64)
         r = quat_to_matrix(tcp_pose[3:7])
         self.phase_steps += 1
@@ -367,6 +374,14 @@ class ScriptedOpener:
         self._slip_count = 0
         self._set(Phase.PULL)
 
+    def _wrist_at_limit(self) -> bool:
+        """Whether one of the arm's wrist joints is within ``wrist_limit_margin`` of its limit."""
+        margin = self.cfg.wrist_limit_margin
+        if margin <= 0.0 or self._arm_qpos is None or self._arm_qpos.size < 7:
+            return False
+        wrist = self._arm_qpos[4:7]
+        return bool(np.any(wrist < _WRIST_LOWER + margin) or np.any(wrist > _WRIST_UPPER - margin))
+
     def _braked(self) -> bool:
         """Whether the hand, pulling at a cruising speed (median step of this pull, at least
         ``limit_min_speed_m`` m), moved less than ``limit_slowdown`` of it in each of the last
@@ -442,6 +457,10 @@ class ScriptedOpener:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
             self._grasp_again = state < target and not at_limit and self.regrasps < cfg.max_regrasps
             self.regrasps += int(self._grasp_again)
+            if self._grasp_again and stalled and self._wrist_at_limit():
+                # the arm ran out of range with this finger order: the other one turns the wrist
+                # the other way
+                self._other_fingers = True
             self._set(Phase.RELEASE)
             action = np.zeros(7, np.float32)
             action[6] = GRIPPER_CLOSE
@@ -459,6 +478,13 @@ class ScriptedOpener:
         if revolute:
             delta = state - self._grasp_state + cfg.revolute_lead
             p_des = pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - pivot)
+            if self._lid and self._lift and cfg.lid_lift_inward > 0.0:
+                # lifting from below, the fingertips slide towards the hinge as the lid turns: off
+                # the lid's own arc (an estimated hinge a centimetre or two off), they stay under it
+                radial = p_des - pivot
+                radial -= float(radial @ u) * u
+                inward = min(cfg.lid_lift_inward * max(delta, 0.0), 0.5 * float(np.linalg.norm(radial)))
+                p_des = p_des - inward * unit(radial)
             if is_vertical_hinge(est, cfg):
                 follow = 1.0
             elif self._lid:

@@ -9,7 +9,15 @@ from scipy.spatial.transform import Rotation
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
 from agents.scripted.geometry import axis_angle_matrix, fit_circle, swept_angle
-from agents.scripted.opener import Phase, grasp_rotation, grasp_target, is_lid, lift_pose, outward_normal
+from agents.scripted.opener import (
+    ACTION_SCALE_M,
+    Phase,
+    grasp_rotation,
+    grasp_target,
+    is_lid,
+    lift_pose,
+    outward_normal,
+)
 from agents.scripted.rollout import make_env, run_episode
 from capt_env.wrappers.estimate import JointAxisEstimate
 from perception.yaml_config import ConfigError, from_dict
@@ -71,6 +79,27 @@ def test_a_lip_the_fingers_closed_on_nothing_is_lifted_from_below() -> None:
     assert opener.phase == Phase.PULL and not opener._lift
 
 
+def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_hinge() -> None:
+    est = _closed_laptop()
+    hinge_y = est.direction
+    start = est.grasp_point - np.array([0.0, 0.0, 0.01])  # fingertips under the lip
+    now = est.pivot + axis_angle_matrix(hinge_y, 0.5) @ (start - est.pivot)  # the lip up 0.5 rad
+
+    def commanded(inward: float) -> np.ndarray:
+        """The TCP translation (m) the opener commands from ``now``, lifting with ``inward``."""
+        opener = ScriptedOpener(ScriptedOpenerConfig(lid_lift_inward=inward, max_step_m=1.0))
+        opener._lid = opener._lift = True
+        opener._start_pull(start, np.eye(3), est)
+        return opener._pull(est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
+
+    plain, inward = commanded(0.0), commanded(0.02)
+    goal = now + plain
+    radial = goal - est.pivot
+    radial -= (radial @ hinge_y) * hinge_y
+    # 0.02 m per radian of the goal's angle (the lid's 0.5 rad plus the 0.12 rad lead), towards the hinge
+    np.testing.assert_allclose(inward - plain, -0.02 * 0.62 * radial / np.linalg.norm(radial), atol=1e-6)
+
+
 def _closed_drawer() -> JointAxisEstimate:
     # a drawer sliding out along -x, its handle at (0.1, 0, 0.1)
     return JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.zeros(3), 0.0,
@@ -113,6 +142,40 @@ def test_fingers_that_closed_on_nothing_grasp_again_the_other_way_round() -> Non
         for _ in range(cfg.close_steps):
             opener.act_on(est, at_handle, finger_gap=gap)
         assert opener.phase == phase and opener.regrasps == 0
+
+
+def _oven() -> JointAxisEstimate:
+    # an oven door hinged along +y at its bottom edge (x = -0.1, z = 0.1), opening down towards -x,
+    # its handle 0.2 m above the hinge
+    return JointAxisEstimate("revolute", np.array([0.0, 1.0, 0.0]), np.array([-0.1, 0.0, 0.1]), 0.0,
+                             np.array([-0.12, 0.0, 0.3]))
+
+
+def _stalled_pull(arm_qpos: np.ndarray | None, cfg: ScriptedOpenerConfig) -> ScriptedOpener:
+    """An opener whose hand holds the oven's handle and does not move for stall_steps + 2 steps."""
+    est = _oven()
+    opener = ScriptedOpener(cfg)
+    at_handle = _pose(grasp_rotation(est, np.eye(3), cfg), est.grasp_point)
+    opener.act_on(est, at_handle)
+    opener._start_pull(est.grasp_point, grasp_rotation(est, np.eye(3), cfg), est)
+    for _ in range(cfg.stall_steps + 2):
+        opener.act_on(est, at_handle, finger_gap=0.02, arm_qpos=arm_qpos)
+        if opener.phase != Phase.PULL:
+            break
+    return opener
+
+
+def test_a_pull_stalled_with_the_wrist_at_its_limit_grasps_again_the_other_way_round() -> None:
+    cfg = ScriptedOpenerConfig()
+    free = np.array([0.0, 0.3, 0.0, -2.0, 0.0, 2.0, 0.8])
+    at_limit = free.copy()
+    at_limit[4] = -2.89  # joint 5 within wrist_limit_margin of -2.8973 rad
+    opener = _stalled_pull(at_limit, cfg)
+    assert opener.phase == Phase.RELEASE and opener.regrasps == 1 and opener._other_fingers
+    # a stall with the wrist free, with no joint angles, or with the option off grasps again as before
+    for qpos, config in ((free, cfg), (None, cfg), (at_limit, ScriptedOpenerConfig(wrist_limit_margin=0.0))):
+        opener = _stalled_pull(qpos, config)
+        assert opener.phase == Phase.RELEASE and opener.regrasps == 1 and not opener._other_fingers
 
 
 def test_doors_and_drawers_are_not_lids() -> None:
@@ -174,6 +237,8 @@ def test_bad_opener_config_is_rejected() -> None:
         from_dict(ScriptedOpenerConfig, {"lid_lift_pitch": 2.0})
     with pytest.raises(ConfigError, match="lid_lift_below"):
         from_dict(ScriptedOpenerConfig, {"lid_lift_below": -0.01})
+    with pytest.raises(ConfigError, match="wrist_limit_margin"):
+        from_dict(ScriptedOpenerConfig, {"wrist_limit_margin": -0.1})
 
 
 def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
