@@ -32,8 +32,8 @@ def tiny(**changes: object) -> PPOTrainConfig:
 # the opener options each shipped residual policy was trained (and measured) with, pinned in its
 # run config so that later changes to the opener's defaults do not change the policy
 SHIPPED_OPENERS = {
-    "laptop": {"arc_fit": False, "regrasp_other_fingers": False, "approach_gap": 0.045,
-               "wrist_limit_margin": 0.0, "lid_lift_inward": 0.0},
+    "laptop": {"arc_fit": True, "regrasp_other_fingers": True, "approach_gap": 0.06,
+               "wrist_limit_margin": 0.05, "lid_lift_inward": 0.02},
     "drawer_cabinet": {"arc_fit": True, "regrasp_other_fingers": True, "approach_gap": 0.06,
                        "wrist_limit_margin": 0.05},
 }
