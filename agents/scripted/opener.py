@@ -457,11 +457,9 @@ class ScriptedOpener:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
             self._grasp_again = state < target and not at_limit and self.regrasps < cfg.max_regrasps
             self.regrasps += int(self._grasp_again)
-            holding = finger_gap is not None and finger_gap >= cfg.hold_gap
-            if self._grasp_again and stalled and holding and self._wrist_at_limit():
-                # the hand still holds the part but the arm ran out of range with this finger order:
-                # the other one turns the wrist the other way (a hand that slipped off grasps again
-                # as it was, without half a turn of the wrist)
+            if self._grasp_again and stalled and self._wrist_at_limit():
+                # the arm ran out of range with this finger order: the other one turns the wrist
+                # the other way
                 self._other_fingers = True
             self._set(Phase.RELEASE)
             action = np.zeros(7, np.float32)
