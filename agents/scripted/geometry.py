@@ -39,14 +39,18 @@ def clip_norm(v: np.ndarray, max_norm: float) -> np.ndarray:
     return v if n <= max_norm else v * (max_norm / n)
 
 
+def off_axis(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """The part (3,) of vector ``v`` (3,) perpendicular to unit ``axis`` (3,)."""
+    v = np.asarray(v, dtype=np.float64)
+    return v - float(v @ axis) * axis
+
+
 def swept_angle(axis: np.ndarray, pivot: np.ndarray, start: np.ndarray, now: np.ndarray) -> float:
     """Signed angle (radians, right-handed about unit ``axis``) that carries point ``start`` (3,) to
     point ``now`` (3,) about the line through ``pivot`` (3,); components along the axis are ignored.
     0 when either point lies on the line."""
-    a = np.asarray(start, dtype=np.float64) - pivot
-    b = np.asarray(now, dtype=np.float64) - pivot
-    a = a - float(a @ axis) * axis
-    b = b - float(b @ axis) * axis
+    a = off_axis(np.asarray(start, dtype=np.float64) - pivot, axis)
+    b = off_axis(np.asarray(now, dtype=np.float64) - pivot, axis)
     if np.linalg.norm(a) < 1e-6 or np.linalg.norm(b) < 1e-6:
         return 0.0
     return float(np.arctan2(float(np.cross(a, b) @ axis), float(a @ b)))

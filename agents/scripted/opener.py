@@ -56,6 +56,7 @@ from agents.scripted.geometry import (
     clip_norm,
     fit_circle,
     grasp_frame,
+    off_axis,
     perpendicular,
     quat_to_matrix,
     rotation_error,
@@ -185,6 +186,15 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
     return nearer_finger_order(frame, current)
 
 
+def wrist_at_limit(arm_qpos: np.ndarray | None, margin: float) -> bool:
+    """Whether one of the Panda's wrist joints (5, 6, 7) in ``arm_qpos`` (7,) rad is within ``margin``
+    rad of its limit; False for no joint angles or a margin of 0 (off)."""
+    if arm_qpos is None or margin <= 0.0:
+        return False
+    wrist = np.asarray(arm_qpos, dtype=np.float64).reshape(-1)[4:7]
+    return bool(np.any(wrist < _WRIST_LOWER + margin) or np.any(wrist > _WRIST_UPPER - margin))
+
+
 def nearer_finger_order(frame: np.ndarray, current: np.ndarray) -> np.ndarray:
     """Of TCP rotation ``frame`` (3, 3) and the same approach with the fingers swapped, the one
     nearer the current rotation ``current`` (3, 3)."""
@@ -229,7 +239,6 @@ class ScriptedOpener:
         self._still = 0
         self._last_p: np.ndarray | None = None
         self._last_err = (0.0, 0.0)
-        self._arm_qpos: np.ndarray | None = None
 
     # --------------------------------------------------------------- helpers
     def _goto(self, p: np.ndarray, r: np.ndarray, p_des: np.ndarray, r_des: np.ndarray,
@@ -274,7 +283,6 @@ class ScriptedOpener:
         stalls with a wrist joint at its limit grasps again with the fingers the other way round.
         """
         cfg = self.cfg
-        self._arm_qpos = None if arm_qpos is None else np.asarray(arm_qpos, dtype=np.float64).reshape(-1)
         p = np.asarray(tcp_pose[:3], dtype=np.float64)
         r = quat_to_matrix(tcp_pose[3:7])
         self.phase_steps += 1
@@ -337,7 +345,7 @@ class ScriptedOpener:
             return action
 
         if self.phase == Phase.PULL:
-            return self._pull(est, p, r, finger_gap)
+            return self._pull(est, p, r, finger_gap, arm_qpos)
 
         if self.phase == Phase.RELEASE:
             action = np.zeros(7, np.float32)
@@ -374,14 +382,6 @@ class ScriptedOpener:
         self._slip_count = 0
         self._set(Phase.PULL)
 
-    def _wrist_at_limit(self) -> bool:
-        """Whether one of the arm's wrist joints is within ``wrist_limit_margin`` of its limit."""
-        margin = self.cfg.wrist_limit_margin
-        if margin <= 0.0 or self._arm_qpos is None or self._arm_qpos.size < 7:
-            return False
-        wrist = self._arm_qpos[4:7]
-        return bool(np.any(wrist < _WRIST_LOWER + margin) or np.any(wrist > _WRIST_UPPER - margin))
-
     def _braked(self) -> bool:
         """Whether the hand, pulling at a cruising speed (median step of this pull, at least
         ``limit_min_speed_m`` m), moved less than ``limit_slowdown`` of it in each of the last
@@ -413,14 +413,14 @@ class ScriptedOpener:
         if fit is None or fit[2] > cfg.arc_fit_max_rms:
             return pivot
         offset = fit[0] - pivot
-        if np.linalg.norm(offset - float(offset @ u) * u) > cfg.arc_fit_max_shift:
+        if np.linalg.norm(off_axis(offset, u)) > cfg.arc_fit_max_shift:
             return pivot
         # kept for the rest of the pull: a hand that later slips off the handle leaves the arc
         self._hinge_fit = fit[0]
         return fit[0]
 
     def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
-              finger_gap: float | None = None) -> np.ndarray:
+              finger_gap: float | None = None, arm_qpos: np.ndarray | None = None) -> np.ndarray:
         cfg = self.cfg
         assert self._grasp_p is not None and self._grasp_r is not None
         revolute = est.joint_type == "revolute"
@@ -457,7 +457,7 @@ class ScriptedOpener:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
             self._grasp_again = state < target and not at_limit and self.regrasps < cfg.max_regrasps
             self.regrasps += int(self._grasp_again)
-            if self._grasp_again and stalled and self._wrist_at_limit():
+            if self._grasp_again and stalled and wrist_at_limit(arm_qpos, cfg.wrist_limit_margin):
                 # the arm ran out of range with this finger order: the other one turns the wrist
                 # the other way
                 self._other_fingers = True
@@ -481,10 +481,10 @@ class ScriptedOpener:
             if self._lid and self._lift and cfg.lid_lift_inward > 0.0:
                 # lifting from below, the fingertips slide towards the hinge as the lid turns: off
                 # the lid's own arc (an estimated hinge a centimetre or two off), they stay under it
-                radial = p_des - pivot
-                radial -= float(radial @ u) * u
-                inward = min(cfg.lid_lift_inward * max(delta, 0.0), 0.5 * float(np.linalg.norm(radial)))
-                p_des = p_des - inward * unit(radial)
+                radial = off_axis(p_des - pivot, u)
+                radius = float(np.linalg.norm(radial))
+                if radius > 1e-6:
+                    p_des = p_des - min(cfg.lid_lift_inward * max(delta, 0.0), 0.5 * radius) * radial / radius
             if is_vertical_hinge(est, cfg):
                 follow = 1.0
             elif self._lid:
