@@ -36,8 +36,10 @@ class ScriptedOpenerConfig:
     fingers), the hand backs off and lifts the lid from below (``lid_lift``): fingers closed, pointing at
     the hinge ``lid_lift_pitch`` rad below horizontal, the fingertips go ``lid_lift_below`` m under the
     grasp point, from ``lid_lift_front`` m in front of it to ``lid_lift_under`` m behind it, and push the
-    lid open along the same arc as a pull, the hand turning by ``lid_lift_wrist_follow`` of the lid's
-    angle and moving ``lid_lift_inward`` m towards the hinge per radian the lid has turned (on an
+    lid open along the same arc as a pull, ``lid_lift_lead`` rad ahead of it (pushing from below, the
+    fingertips carry the lid's weight; the larger lead pushes harder, through the stall near 0.4 rad
+    that a lead of ``revolute_lead`` met with an estimated hinge), the hand turning by
+    ``lid_lift_wrist_follow`` of the lid's angle and moving ``lid_lift_inward`` m towards the hinge per radian the lid has turned (on an
     estimated hinge 1-2 cm off, the fingertips following its arc slid off the lip at about 1.2 rad;
     sliding towards the hinge they stay under the lid). ``close_steps`` steps close the gripper. Pulling
     leads the part by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a door about a
@@ -95,6 +97,7 @@ class ScriptedOpenerConfig:
     lid_lift_under: float = 0.0
     lid_lift_wrist_follow: float = 0.0
     lid_lift_inward: float = 0.02
+    lid_lift_lead: float = 0.2
     close_steps: int = 8
     revolute_lead: float = 0.12
     prismatic_lead: float = 0.03
@@ -123,7 +126,7 @@ class ScriptedOpenerConfig:
 
     def validate(self) -> None:
         for key in ("pregrasp_offset", "max_step_m", "max_step_rad", "pos_tolerance", "rot_tolerance",
-                    "revolute_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
+                    "revolute_lead", "lid_lift_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
                     "revolute_target", "prismatic_target", "lid_revolute_target",
                     "slip_distance", "hold_gap", "limit_min_speed_m", "arc_fit_min_chord",
                     "arc_fit_min_angle", "arc_fit_max_rms", "arc_fit_max_shift"):

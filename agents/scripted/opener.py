@@ -476,7 +476,8 @@ class ScriptedOpener:
             action[6] = GRIPPER_OPEN
             return action
         if revolute:
-            delta = state - self._grasp_state + cfg.revolute_lead
+            lead = cfg.lid_lift_lead if self._lid and self._lift else cfg.revolute_lead
+            delta = state - self._grasp_state + lead
             p_des = pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - pivot)
             if self._lid and self._lift and cfg.lid_lift_inward > 0.0:
                 # lifting from below, the fingertips slide towards the hinge as the lid turns: off

@@ -87,7 +87,8 @@ def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_
 
     def commanded(inward: float) -> np.ndarray:
         """The TCP translation (m) the opener commands from ``now``, lifting with ``inward``."""
-        opener = ScriptedOpener(ScriptedOpenerConfig(lid_lift_inward=inward, max_step_m=1.0))
+        opener = ScriptedOpener(ScriptedOpenerConfig(lid_lift_inward=inward, lid_lift_lead=0.12,
+                                                     max_step_m=1.0))
         opener._lid = opener._lift = True
         opener._start_pull(start, np.eye(3), est)
         return opener._pull(est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
@@ -99,6 +100,29 @@ def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_
     # 0.02 m per radian of the goal's angle (the lid's 0.5 rad plus the 0.12 rad lead), towards the hinge
     np.testing.assert_allclose(inward - plain, -0.02 * 0.62 * radial / np.linalg.norm(radial), atol=1e-6)
 
+
+
+def test_a_lid_lifted_from_below_leads_by_lid_lift_lead_and_a_gripped_one_by_revolute_lead() -> None:
+    est = _closed_laptop()
+    hinge_y = est.direction
+    start = est.grasp_point - np.array([0.0, 0.0, 0.01])
+    now = est.pivot + axis_angle_matrix(hinge_y, 0.5) @ (start - est.pivot)  # the lip up 0.5 rad
+
+    def goal(lift: bool, lift_lead: float) -> np.ndarray:
+        """Where the opener sends the TCP (m, world) from ``now``, in one uncapped step."""
+        cfg = ScriptedOpenerConfig(lid_lift_inward=0.0, lid_lift_lead=lift_lead, revolute_lead=0.12,
+                                   max_step_m=1.0)
+        opener = ScriptedOpener(cfg)
+        opener._lid, opener._lift = True, lift
+        opener._start_pull(start, np.eye(3), est)
+        return now + opener._pull(est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
+
+    for lead in (0.12, 0.3):
+        expected = est.pivot + axis_angle_matrix(hinge_y, 0.5 + lead) @ (start - est.pivot)
+        np.testing.assert_allclose(goal(True, lead), expected, atol=1e-6)
+    # a lid gripped by its lip (no lift) keeps the revolute lead whatever the lift's lead is
+    gripped = est.pivot + axis_angle_matrix(hinge_y, 0.62) @ (start - est.pivot)
+    np.testing.assert_allclose(goal(False, 0.3), gripped, atol=1e-6)
 
 def _closed_drawer() -> JointAxisEstimate:
     # a drawer sliding out along -x, its handle at (0.1, 0, 0.1)
