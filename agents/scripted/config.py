@@ -39,14 +39,15 @@ class ScriptedOpenerConfig:
     lid open along the same arc as a pull, ``lid_lift_lead`` rad ahead of it (pushing from below, the
     fingertips carry the lid's weight; the larger lead pushes harder, through the stall near 0.4 rad
     that a lead of ``revolute_lead`` met with an estimated hinge), the hand turning by
-    ``lid_lift_wrist_follow`` of the lid's angle and moving ``lid_lift_inward`` m towards the hinge per radian the lid has turned (on an
-    estimated hinge 1-2 cm off, the fingertips following its arc slid off the lip at about 1.2 rad;
-    sliding towards the hinge they stay under the lid). ``close_steps`` steps close the gripper. Pulling
-    leads the part by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand turns with a door about a
-    vertical hinge, and by ``wrist_follow`` of the part's angle about any other hinge (a grasped bar turns
-    between the pads; a hand turned fully with an oven door reaches the Panda's wrist limit). Pulling
-    stops at ``revolute_target`` rad / ``prismatic_target`` m, or when the state grew by less than
-    ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit, or a lost grip).
+    ``lid_lift_wrist_follow`` of the lid's angle and moving ``lid_lift_inward`` m towards the hinge per
+    radian the lid has turned (on an estimated hinge 1-2 cm off, the fingertips following its arc slid off
+    the lip at about 1.2 rad; sliding towards the hinge they stay under the lid). ``close_steps`` steps
+    close the gripper. Pulling leads the part by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand
+    turns with a door about a vertical hinge, and by ``wrist_follow`` of the part's angle about any other
+    hinge (a grasped bar turns between the pads; a hand turned fully with an oven door reaches the Panda's
+    wrist limit). Pulling stops at ``revolute_target`` rad / ``prismatic_target`` m, or when the state
+    grew by less than ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit,
+    or a lost grip).
     The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than ``slip_distance`` m from
     the part's perceived grasp point for ``slip_steps`` steps (longer than the perception period, so one
     bad estimate, e.g. of a handle the hand now hides, is not a slip) and its fingers are less than
@@ -61,6 +62,14 @@ class ScriptedOpenerConfig:
     of the handle. A pull that stalls with one of the Panda's wrist joints (5, 6, 7) within
     ``wrist_limit_margin`` rad of its limit (0: off) grasps again that way too: the arm ran out of range
     with this finger order (oven doors), and grasping again the same way returns it to the same limit.
+    A door that gravity opens further once let go (hinged below its grasp point about a non-vertical
+    axis and not a lid: an oven door) is not grasped again once the pull ends (stall or slip) past
+    ``fall_open_done`` rad (reaching for the handle of a door near level pushes it back); short of
+    that but past ``settle_above`` rad (a door let go nearer closed falls too slowly to wait for), the
+    open hand backs off, moves ``settle_clearance`` m beyond the grasp radius about the
+    estimated hinge (out of the door's sweep) and waits while the perceived state still rises by
+    ``stall_progress`` rad over ``settle_window`` steps (at most ``settle_max_steps``), then is done
+    if the door fell past ``fall_open_done`` and grasps again otherwise (``fall_open_done`` 0: off).
     With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
     fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
     estimated hinge) from where the pull began, a circle is fitted to its path about the estimated axis
@@ -117,6 +126,11 @@ class ScriptedOpenerConfig:
     regrasp_other_fingers: bool = True
     wrist_limit_margin: float = 0.05
     retreat_distance: float = 0.08
+    fall_open_done: float = 1.3
+    settle_above: float = 0.8
+    settle_clearance: float = 0.1
+    settle_window: int = 10
+    settle_max_steps: int = 40
     release_steps: int = 6
     arc_fit: bool = True
     arc_fit_min_chord: float = 0.06
@@ -136,7 +150,7 @@ class ScriptedOpenerConfig:
         require(self.rotate_first_steps >= 0,
                 f"rotate_first_steps must be >= 0 (0: never), got {self.rotate_first_steps}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",
-                    "slip_steps", "limit_window"):
+                    "slip_steps", "limit_window", "settle_window", "settle_max_steps"):
             require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")
         require(0.0 < self.approach_gap <= 0.08,
                 f"approach_gap must be in (0, 0.08] m, got {self.approach_gap}")
@@ -153,6 +167,11 @@ class ScriptedOpenerConfig:
         require(0.0 < self.limit_slowdown < 1.0,
                 f"limit_slowdown must be in (0, 1), got {self.limit_slowdown}")
         require(self.max_regrasps >= 0, "max_regrasps must be >= 0")
+        require(self.fall_open_done >= 0,
+                f"fall_open_done must be >= 0 rad (0: off), got {self.fall_open_done}")
+        require(self.settle_above >= 0, f"settle_above must be >= 0 rad, got {self.settle_above}")
+        require(self.settle_clearance >= 0,
+                f"settle_clearance must be >= 0 m, got {self.settle_clearance}")
         require(0.0 <= self.wrist_limit_margin < 0.5,
                 f"wrist_limit_margin must be in [0, 0.5) rad (0: off), got {self.wrist_limit_margin}")
         for key in ("approach_pitch", "vertical_hinge_pitch", "vertical_hinge_max_tilt", "lid_max_tilt"):

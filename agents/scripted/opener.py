@@ -40,7 +40,9 @@ have closed on nothing (their gap, from the Panda's qpos, below ``hold_gap``), i
 if pulling stalls short of the target (a slipping grip, or the arm's range), it releases, retreats
 and goes back to 1 from the part's new pose (re-grasps are bounded by ``max_regrasps``). A prismatic
 part that brakes the pulling hand (see ``limit_slowdown``) has reached its end stop: the hand
-releases, retreats and is done.
+releases, retreats and is done. A door that gravity opens (:func:`falls_open`, an oven door) is
+not grasped again once the hand loses it past ``fall_open_done``; short of that, the open hand moves
+out of the door's sweep and waits while it falls, then is done or grasps again (``RETREAT``).
 """
 
 from __future__ import annotations
@@ -118,6 +120,17 @@ def is_lid(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
         return False
     return float(outward_normal(est)[2]) >= float(np.cos(cfg.lid_max_tilt))
 
+
+
+def falls_open(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
+    """Whether ``est`` is a part that gravity opens further once it is let go: a revolute part about
+    a non-vertical hinge whose grasp point, closed (turned back by the estimated state), is above
+    the hinge line, and which is not a lid (an oven door, hinged at its foot)."""
+    if est.joint_type != "revolute" or is_vertical_hinge(est, cfg) or is_lid(est, cfg):
+        return False
+    u = unit(est.direction)
+    closed = axis_angle_matrix(u, -float(est.state)) @ (est.grasp_point - est.pivot)
+    return float(off_axis(closed, u)[2]) > 0.0
 
 def lid_frame(est: JointAxisEstimate) -> tuple[np.ndarray, np.ndarray] | None:
     """World unit directions (front, up) at a lid's grasp point: ``front`` along the radius from the
@@ -235,6 +248,9 @@ class ScriptedOpener:
         self._slip_count = 0
         self._retreat_from: np.ndarray | None = None
         self._grasp_again = False
+        self._falls = False  # the part being pulled falls open when let go (see falls_open)
+        self._let_go_state = 0.0  # the part's state (rad or m) when the hand last let go of it
+        self._settle: list[float] | None = None  # perceived states while waiting for a falling part
         self._other_fingers = False  # the next grasp turns the fingers the other way round
         self._still = 0
         self._last_p: np.ndarray | None = None
@@ -357,10 +373,14 @@ class ScriptedOpener:
 
         if self.phase == Phase.RETREAT:
             assert self._retreat_from is not None
+            if self._settle is not None:
+                return self._settle_step(est, p, r)
             goal = self._retreat_from - r[:, 2] * cfg.retreat_distance
             action, perr, _ = self._goto(p, r, goal, r, GRIPPER_OPEN)
             if self._reached(p, perr, 0.0):  # there, timed out, or blocked (the arm's range)
-                if self._grasp_again:
+                if self._grasp_again and self._lets_fall() and self._let_go_state >= cfg.settle_above:
+                    self._settle = []
+                elif self._grasp_again:
                     self._grasp_again = False
                     self._target_r = None
                     self._set(Phase.PREGRASP)
@@ -375,6 +395,7 @@ class ScriptedOpener:
     def _start_pull(self, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate) -> None:
         self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
         self._grasp_u = unit(est.direction)
+        self._falls = falls_open(est, self.cfg)
         self._history = []
         self._pulled = [p.copy()]
         self._held = [p.copy()]
@@ -419,6 +440,43 @@ class ScriptedOpener:
         self._hinge_fit = fit[0]
         return fit[0]
 
+    def _lets_fall(self) -> bool:
+        """Whether to let the part being pulled fall open when the hand loses it: it
+        :func:`falls_open` by the estimate the pull began with (one of a door near level, its handle
+        hidden by the hand, can be far off) and ``fall_open_done`` > 0."""
+        return self.cfg.fall_open_done > 0.0 and self._falls
+
+    def _settle_step(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """After letting go of a door that falls open, at least ``settle_above`` rad open: move the
+        open hand out of its sweep, to ``settle_clearance`` m beyond the grasp radius about the
+        estimated hinge, and wait while the perceived state still rises (by ``stall_progress`` rad
+        over ``settle_window`` steps; at most ``settle_max_steps``). Then done if the state reached
+        ``fall_open_done`` rad, else grasp again."""
+        cfg = self.cfg
+        assert self._settle is not None and self._grasp_p is not None
+        u = unit(est.direction)
+        radial = off_axis(p - est.pivot, u)
+        radius = float(np.linalg.norm(radial))
+        goal = p
+        if radius > 1e-6:
+            clear = float(np.linalg.norm(off_axis(self._grasp_p - est.pivot, u))) + cfg.settle_clearance
+            goal = p + max(clear - radius, 0.0) * radial / radius
+        action, _, _ = self._goto(p, r, goal, r, GRIPPER_OPEN)
+        self._settle.append(float(est.state))
+        states = self._settle
+        rising = len(states) <= cfg.settle_window or (
+            states[-1] - states[-1 - cfg.settle_window] >= cfg.stall_progress)
+        if rising and len(states) < cfg.settle_max_steps:
+            return action
+        self._settle = None
+        self._grasp_again = False
+        if est.state >= cfg.fall_open_done:
+            self._set(Phase.DONE)
+        else:
+            self._target_r = None
+            self._set(Phase.PREGRASP)
+        return action
+
     def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
               finger_gap: float | None = None, arm_qpos: np.ndarray | None = None) -> np.ndarray:
         cfg = self.cfg
@@ -456,7 +514,11 @@ class ScriptedOpener:
         if state >= target or stalled or at_limit:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
             self._grasp_again = state < target and not at_limit and self.regrasps < cfg.max_regrasps
+            if self._grasp_again and self._lets_fall() and state >= cfg.fall_open_done:
+                # a door that falls open, past fall_open_done: grasping it again pushes it back
+                self._grasp_again = False
             self.regrasps += int(self._grasp_again)
+            self._let_go_state = state
             if self._grasp_again and stalled and wrist_at_limit(arm_qpos, cfg.wrist_limit_margin):
                 # the arm ran out of range with this finger order: the other one turns the wrist
                 # the other way
@@ -468,6 +530,17 @@ class ScriptedOpener:
         holding = finger_gap is not None and finger_gap >= cfg.hold_gap
         far = np.linalg.norm(p - est.grasp_point) > cfg.slip_distance and not holding
         self._slip_count = self._slip_count + 1 if far else 0
+        if (self._slip_count >= cfg.slip_steps and self._lets_fall()
+                and est.state >= cfg.settle_above):
+            # off the handle of a door that falls open: let go, clear it and wait (see RETREAT)
+            # instead of reaching for a handle on the move; past fall_open_done it is left open
+            self._grasp_again = est.state < cfg.fall_open_done and self.regrasps < cfg.max_regrasps
+            self.regrasps += int(self._grasp_again)
+            self._let_go_state = float(est.state)
+            self._set(Phase.RELEASE)
+            action = np.zeros(7, np.float32)
+            action[6] = GRIPPER_OPEN
+            return action
         if self._slip_count >= cfg.slip_steps and self.regrasps < cfg.max_regrasps:
             self.regrasps += 1
             self._target_r = None

@@ -12,6 +12,7 @@ from agents.scripted.geometry import axis_angle_matrix, fit_circle, swept_angle
 from agents.scripted.opener import (
     ACTION_SCALE_M,
     Phase,
+    falls_open,
     grasp_rotation,
     grasp_target,
     is_lid,
@@ -202,6 +203,108 @@ def test_a_pull_stalled_with_the_wrist_at_its_limit_grasps_again_the_other_way_r
         assert opener.phase == Phase.RELEASE and opener.regrasps == 1 and not opener._other_fingers
 
 
+
+def _falling_oven(state: float) -> JointAxisEstimate:
+    # an oven door hinged along -y at its foot (x = 0.1, z = 0.1), its handle 0.25 m above the hinge,
+    # opening down towards the robot (-x), turned ``state`` rad open
+    u, pivot = np.array([0.0, -1.0, 0.0]), np.array([0.1, 0.0, 0.1])
+    handle = pivot + axis_angle_matrix(u, state) @ np.array([-0.02, 0.0, 0.25])
+    return JointAxisEstimate("revolute", u, pivot, state, handle)
+
+
+def test_doors_that_gravity_opens_are_told_from_lids_side_doors_and_top_hinged_flaps() -> None:
+    cfg = ScriptedOpenerConfig()
+    assert falls_open(_falling_oven(0.0), cfg)
+    # 1.6 rad open the handle is below the hinge; the closed pose (turned back by the state) counts
+    assert _falling_oven(1.6).grasp_point[2] < 0.1 and falls_open(_falling_oven(1.6), cfg)
+    side_door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]),
+                                  0.0, np.array([-0.1, 0.2, 0.3]))
+    flap = JointAxisEstimate("revolute", np.array([0.0, 1.0, 0.0]), np.array([0.1, 0.0, 0.4]), 0.0,
+                             np.array([0.08, 0.0, 0.15]))  # hinged above its handle
+    drawer = _closed_drawer()
+    for est in (_closed_laptop(), side_door, flap, drawer):
+        assert not falls_open(est, cfg)
+
+
+def _pull_stalled_at(state: float, cfg: ScriptedOpenerConfig) -> tuple[ScriptedOpener, np.ndarray]:
+    """An opener that grasped the closed falling oven and whose hand stopped with the door ``state``
+    rad open; returns it, released, and the hand's pose (7,)."""
+    closed = _falling_oven(0.0)
+    rot = grasp_rotation(closed, np.eye(3), cfg)
+    opener = ScriptedOpener(cfg)
+    opener.act_on(closed, _pose(rot, closed.grasp_point))
+    opener._start_pull(closed.grasp_point, rot, closed)
+    est = _falling_oven(state)
+    at = _pose(rot, est.grasp_point)
+    for _ in range(cfg.stall_steps + 2):
+        opener.act_on(est, at)
+    assert opener.phase == Phase.RELEASE
+    for _ in range(cfg.release_steps):
+        opener.act_on(est, at)
+    assert opener.phase == Phase.RETREAT
+    return opener, at
+
+
+def _hold_until_phase_changes(opener: ScriptedOpener, est: JointAxisEstimate, pose: np.ndarray,
+                              limit: int = 100) -> list[np.ndarray]:
+    """Steps the opener with the hand held still at ``pose`` until its phase changes; the actions."""
+    phase, actions = opener.phase, []
+    while opener.phase == phase and len(actions) < limit:
+        actions.append(opener.act_on(est, pose))
+    return actions
+
+
+def test_a_door_that_falls_open_past_fall_open_done_is_let_go_for_good() -> None:
+    cfg = ScriptedOpenerConfig()
+    opener, at = _pull_stalled_at(cfg.fall_open_done + 0.1, cfg)
+    assert not opener._grasp_again and opener.regrasps == 0
+    _hold_until_phase_changes(opener, _falling_oven(cfg.fall_open_done + 0.1), at)
+    assert opener.phase == Phase.DONE
+
+
+def test_a_door_let_go_short_of_open_is_cleared_and_waited_for_while_it_falls() -> None:
+    cfg = ScriptedOpenerConfig()
+    opener, at = _pull_stalled_at(0.8, cfg)
+    assert opener._grasp_again and opener.regrasps == 1
+    est = _falling_oven(0.8)
+    for _ in range(cfg.move_timeout):  # the retreat ends (blocked: the hand is held still)
+        opener.act_on(est, at)
+        if opener._settle is not None:
+            break
+    # and the hand now waits, still in RETREAT, moving out of the door's sweep: radially away from
+    # the hinge
+    assert opener.phase == Phase.RETREAT and opener._settle is not None
+    radial = at[:3] - est.pivot
+    radial[1] = 0.0
+    step = opener.act_on(est, at)[:3]
+    assert step @ radial / (np.linalg.norm(step) * np.linalg.norm(radial)) == pytest.approx(1.0, abs=1e-6)
+    # the door falls open by 0.02 rad a step: the hand keeps waiting past the settle window
+    for k in range(2 * cfg.settle_window):
+        opener.act_on(_falling_oven(0.8 + 0.02 * k), at)
+    assert opener.phase == Phase.RETREAT
+    # it comes to rest past fall_open_done: done, no grasp again
+    rest = _falling_oven(cfg.fall_open_done + 0.2)
+    actions = _hold_until_phase_changes(opener, rest, at)
+    assert opener.phase == Phase.DONE and len(actions) == cfg.settle_window + 1
+
+
+def test_a_door_that_stays_where_it_was_let_go_is_grasped_again() -> None:
+    cfg = ScriptedOpenerConfig()
+    opener, at = _pull_stalled_at(0.8, cfg)
+    est = _falling_oven(0.8)
+    actions = _hold_until_phase_changes(opener, est, at)  # the retreat, then the wait
+    assert opener.phase == Phase.PREGRASP and len(actions) <= cfg.move_timeout + cfg.settle_window + 1
+    # let go short of settle_above (a door that falls slowly), or without the option, the hand grasps
+    # again right after its retreat, without waiting
+    for state, config in ((cfg.settle_above - 0.1, cfg), (0.8, ScriptedOpenerConfig(fall_open_done=0.0))):
+        opener, at = _pull_stalled_at(state, config)
+        for _ in range(cfg.move_timeout):
+            opener.act_on(_falling_oven(state), at)
+            assert opener._settle is None
+            if opener.phase != Phase.RETREAT:
+                break
+        assert opener.phase == Phase.PREGRASP
+
 def test_doors_and_drawers_are_not_lids() -> None:
     cfg = ScriptedOpenerConfig()
     door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]), 0.0,
@@ -263,6 +366,10 @@ def test_bad_opener_config_is_rejected() -> None:
         from_dict(ScriptedOpenerConfig, {"lid_lift_below": -0.01})
     with pytest.raises(ConfigError, match="wrist_limit_margin"):
         from_dict(ScriptedOpenerConfig, {"wrist_limit_margin": -0.1})
+    with pytest.raises(ConfigError, match="fall_open_done"):
+        from_dict(ScriptedOpenerConfig, {"fall_open_done": -1.0})
+    with pytest.raises(ConfigError, match="settle_window"):
+        from_dict(ScriptedOpenerConfig, {"settle_window": 0})
 
 
 def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
