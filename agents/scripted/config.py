@@ -64,12 +64,12 @@ class ScriptedOpenerConfig:
     with this finger order (oven doors), and grasping again the same way returns it to the same limit.
     A door that gravity opens further once let go (hinged below its grasp point about a non-vertical
     axis and not a lid: an oven door) is not grasped again once the pull ends (stall or slip) past
-    ``fall_open_done`` rad (reaching for the handle of a door near level pushes it back); short of
-    that but past ``settle_above`` rad (a door let go nearer closed falls too slowly to wait for), the
-    open hand backs off, moves ``settle_clearance`` m beyond the grasp radius about the
-    estimated hinge (out of the door's sweep) and waits while the perceived state still rises by
-    ``stall_progress`` rad over ``settle_window`` steps (at most ``settle_max_steps``), then is done
-    if the door fell past ``fall_open_done`` and grasps again otherwise (``fall_open_done`` 0: off).
+    ``fall_open_done`` rad (reaching for the handle of a door near level pushes it back). Let go past
+    ``settle_above`` rad (a door let go nearer closed falls too slowly to wait for), the open hand
+    backs off, moves ``settle_clearance`` m beyond the grasp radius about the estimated hinge (out of
+    the door's sweep) and waits while the perceived state still rises by ``stall_progress`` rad over
+    ``settle_window`` steps (at most ``settle_max_steps``); then it is done if the door fell past
+    ``fall_open_done`` and grasps again otherwise (``fall_open_done`` 0: all of this off).
     With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
     fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
     estimated hinge) from where the pull began, a circle is fitted to its path about the estimated axis

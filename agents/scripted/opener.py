@@ -378,8 +378,8 @@ class ScriptedOpener:
             goal = self._retreat_from - r[:, 2] * cfg.retreat_distance
             action, perr, _ = self._goto(p, r, goal, r, GRIPPER_OPEN)
             if self._reached(p, perr, 0.0):  # there, timed out, or blocked (the arm's range)
-                if self._grasp_again and self._lets_fall() and self._let_go_state >= cfg.settle_above:
-                    self._settle = []
+                if self._lets_fall() and self._let_go_state >= cfg.settle_above:
+                    self._settle = []  # clear the door's sweep, wait while it falls, then decide
                 elif self._grasp_again:
                     self._grasp_again = False
                     self._target_r = None
@@ -450,8 +450,8 @@ class ScriptedOpener:
         """After letting go of a door that falls open, at least ``settle_above`` rad open: move the
         open hand out of its sweep, to ``settle_clearance`` m beyond the grasp radius about the
         estimated hinge, and wait while the perceived state still rises (by ``stall_progress`` rad
-        over ``settle_window`` steps; at most ``settle_max_steps``). Then done if the state reached
-        ``fall_open_done`` rad, else grasp again."""
+        over ``settle_window`` steps; at most ``settle_max_steps``). Then grasp again if the pull
+        ended short of its target and the state is still short of ``fall_open_done`` rad, else done."""
         cfg = self.cfg
         assert self._settle is not None and self._grasp_p is not None
         u = unit(est.direction)
@@ -469,12 +469,12 @@ class ScriptedOpener:
         if rising and len(states) < cfg.settle_max_steps:
             return action
         self._settle = None
-        self._grasp_again = False
-        if est.state >= cfg.fall_open_done:
-            self._set(Phase.DONE)
-        else:
+        again, self._grasp_again = self._grasp_again and est.state < cfg.fall_open_done, False
+        if again:
             self._target_r = None
             self._set(Phase.PREGRASP)
+        else:
+            self._set(Phase.DONE)
         return action
 
     def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
