@@ -67,8 +67,9 @@ class ScriptedOpenerConfig:
     ``fall_open_done`` rad (reaching for the handle of a door near level pushes it back). Let go past
     ``settle_above`` rad (a door let go nearer closed falls too slowly to wait for), the open hand
     backs off, moves ``settle_clearance`` m beyond the grasp radius about the estimated hinge (out of
-    the door's sweep) and waits while the perceived state still rises by ``stall_progress`` rad over
-    ``settle_window`` steps (at most ``settle_max_steps``); then it is done if the door fell past
+    the door's sweep) and waits while the perceived state still rises by ``settle_progress`` rad over
+    ``settle_window`` steps (a door falling open; one that creeps is grasped again; at most
+    ``settle_max_steps``); then it is done if the door fell past
     ``fall_open_done`` and grasps again otherwise (``fall_open_done`` 0: all of this off).
     With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
     fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
@@ -130,6 +131,7 @@ class ScriptedOpenerConfig:
     settle_above: float = 0.8
     settle_clearance: float = 0.1
     settle_window: int = 10
+    settle_progress: float = 0.06
     settle_max_steps: int = 40
     release_steps: int = 6
     arc_fit: bool = True
@@ -143,7 +145,7 @@ class ScriptedOpenerConfig:
                     "revolute_lead", "lid_lift_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
                     "revolute_target", "prismatic_target", "lid_revolute_target",
                     "slip_distance", "hold_gap", "limit_min_speed_m", "arc_fit_min_chord",
-                    "arc_fit_min_angle", "arc_fit_max_rms", "arc_fit_max_shift"):
+                    "arc_fit_min_angle", "arc_fit_max_rms", "arc_fit_max_shift", "settle_progress"):
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         require(self.rotate_first_above > 0,
                 f"rotate_first_above must be > 0 rad, got {self.rotate_first_above}")

@@ -449,7 +449,7 @@ class ScriptedOpener:
     def _settle_step(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray) -> np.ndarray:
         """After letting go of a door that falls open, at least ``settle_above`` rad open: move the
         open hand out of its sweep, to ``settle_clearance`` m beyond the grasp radius about the
-        estimated hinge, and wait while the perceived state still rises (by ``stall_progress`` rad
+        estimated hinge, and wait while the perceived state still rises (by ``settle_progress`` rad
         over ``settle_window`` steps; at most ``settle_max_steps``). Then grasp again if the pull
         ended short of its target and the state is still short of ``fall_open_done`` rad, else done."""
         cfg = self.cfg
@@ -465,7 +465,7 @@ class ScriptedOpener:
         self._settle.append(float(est.state))
         states = self._settle
         rising = len(states) <= cfg.settle_window or (
-            states[-1] - states[-1 - cfg.settle_window] >= cfg.stall_progress)
+            states[-1] - states[-1 - cfg.settle_window] >= cfg.settle_progress)
         if rising and len(states) < cfg.settle_max_steps:
             return action
         self._settle = None
