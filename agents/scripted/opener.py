@@ -121,7 +121,6 @@ def is_lid(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
     return float(outward_normal(est)[2]) >= float(np.cos(cfg.lid_max_tilt))
 
 
-
 def falls_open(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
     """Whether ``est`` is a part that gravity opens further once it is let go: a revolute part about
     a non-vertical hinge whose grasp point, closed (turned back by the estimated state), is above
@@ -131,6 +130,7 @@ def falls_open(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
     u = unit(est.direction)
     closed = axis_angle_matrix(u, -float(est.state)) @ (est.grasp_point - est.pivot)
     return float(off_axis(closed, u)[2]) > 0.0
+
 
 def lid_frame(est: JointAxisEstimate) -> tuple[np.ndarray, np.ndarray] | None:
     """World unit directions (front, up) at a lid's grasp point: ``front`` along the radius from the
@@ -249,7 +249,7 @@ class ScriptedOpener:
         self._retreat_from: np.ndarray | None = None
         self._grasp_again = False
         self._falls = False  # the part being pulled falls open when let go (see falls_open)
-        self._let_go_state = 0.0  # the part's state (rad or m) when the hand last let go of it
+        self._let_go_state = 0.0  # the part's state (rad or m) when a pull last let go of it
         self._settle: list[float] | None = None  # perceived states while waiting for a falling part
         self._other_fingers = False  # the next grasp turns the fingers the other way round
         self._still = 0
@@ -378,7 +378,9 @@ class ScriptedOpener:
             goal = self._retreat_from - r[:, 2] * cfg.retreat_distance
             action, perr, _ = self._goto(p, r, goal, r, GRIPPER_OPEN)
             if self._reached(p, perr, 0.0):  # there, timed out, or blocked (the arm's range)
-                if self._lets_fall() and self._let_go_state >= cfg.settle_above:
+                # (a pull's end sets the state it let go at; fingers that closed on nothing do not)
+                let_go, self._let_go_state = self._let_go_state, 0.0
+                if self._lets_fall() and let_go >= cfg.settle_above:
                     self._settle = []  # clear the door's sweep, wait while it falls, then decide
                 elif self._grasp_again:
                     self._grasp_again = False

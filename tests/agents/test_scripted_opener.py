@@ -269,9 +269,9 @@ def test_a_door_that_falls_open_past_fall_open_done_is_let_go_for_good() -> None
 
 def test_a_door_let_go_short_of_open_is_cleared_and_waited_for_while_it_falls() -> None:
     cfg = ScriptedOpenerConfig()
-    opener, at = _pull_stalled_at(0.8, cfg)
+    opener, at = _pull_stalled_at(1.0, cfg)
     assert opener._grasp_again and opener.regrasps == 1
-    est = _falling_oven(0.8)
+    est = _falling_oven(1.0)
     for _ in range(cfg.move_timeout):  # the retreat ends (blocked: the hand is held still)
         opener.act_on(est, at)
         if opener._settle is not None:
@@ -285,7 +285,7 @@ def test_a_door_let_go_short_of_open_is_cleared_and_waited_for_while_it_falls() 
     assert step @ radial / (np.linalg.norm(step) * np.linalg.norm(radial)) == pytest.approx(1.0, abs=1e-6)
     # the door falls open by 0.02 rad a step: the hand keeps waiting past the settle window
     for k in range(2 * cfg.settle_window):
-        opener.act_on(_falling_oven(0.8 + 0.02 * k), at)
+        opener.act_on(_falling_oven(1.0 + 0.02 * k), at)
     assert opener.phase == Phase.RETREAT
     # it comes to rest past fall_open_done: done, no grasp again
     rest = _falling_oven(cfg.fall_open_done + 0.2)
@@ -295,10 +295,22 @@ def test_a_door_let_go_short_of_open_is_cleared_and_waited_for_while_it_falls() 
 
 def test_a_door_that_stays_where_it_was_let_go_is_grasped_again() -> None:
     cfg = ScriptedOpenerConfig()
-    opener, at = _pull_stalled_at(0.8, cfg)
-    est = _falling_oven(0.8)
+    opener, at = _pull_stalled_at(1.0, cfg)
+    est = _falling_oven(1.0)
     actions = _hold_until_phase_changes(opener, est, at)  # the retreat, then the wait
     assert opener.phase == Phase.PREGRASP and len(actions) <= cfg.move_timeout + cfg.settle_window + 1
+    # fingers that then close on nothing back off and grasp again without another wait: only the
+    # end of a pull lets the door go
+    opener._set(Phase.CLOSE)
+    for _ in range(cfg.close_steps + cfg.release_steps):
+        opener.act_on(est, at, finger_gap=0.0)
+    assert opener.phase == Phase.RETREAT
+    for _ in range(cfg.move_timeout):
+        opener.act_on(est, at)
+        assert opener._settle is None
+        if opener.phase != Phase.RETREAT:
+            break
+    assert opener.phase == Phase.PREGRASP
     # let go short of settle_above (a door that falls slowly), or without the option, the hand grasps
     # again right after its retreat, without waiting
     for state, config in ((cfg.settle_above - 0.1, cfg), (0.8, ScriptedOpenerConfig(fall_open_done=0.0))):
