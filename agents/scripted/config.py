@@ -69,8 +69,8 @@ class ScriptedOpenerConfig:
     backs off, moves ``settle_clearance`` m beyond the grasp radius about the estimated hinge (out of
     the door's sweep) and waits while the perceived state still rises by ``settle_progress`` rad over
     ``settle_window`` steps (a door falling open; one that creeps is grasped again; at most
-    ``settle_max_steps``); then it is done if the door fell past
-    ``fall_open_done`` and grasps again otherwise (``fall_open_done`` 0: all of this off).
+    ``settle_max_steps``); then it is done if the door fell past ``fall_open_done`` and grasps again
+    otherwise (``fall_open_done`` 0: all of this off).
     With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
     fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
     estimated hinge) from where the pull began, a circle is fitted to its path about the estimated axis
