@@ -98,6 +98,14 @@ class Phase(enum.Enum):
     DONE = "done"
 
 
+
+def hold(gripper: float) -> np.ndarray:
+    """Action (7,) that keeps the hand where it is and drives the gripper to ``gripper`` (-1 closed,
+    1 open)."""
+    action = np.zeros(7, np.float32)
+    action[6] = gripper
+    return action
+
 def outward_normal(est: JointAxisEstimate) -> np.ndarray:
     """World-frame unit direction in which the grasp point moves when the part opens."""
     u = unit(est.direction)
@@ -339,8 +347,7 @@ class ScriptedOpener:
             return action
 
         if self.phase == Phase.CLOSE:
-            action = np.zeros(7, np.float32)
-            action[6] = GRIPPER_CLOSE
+            action = hold(GRIPPER_CLOSE)
             if self.phase_steps >= cfg.close_steps:
                 if (self._lid and cfg.lid_lift and not self._lift and finger_gap is not None
                         and finger_gap < cfg.hold_gap):
@@ -364,8 +371,7 @@ class ScriptedOpener:
             return self._pull(est, p, r, finger_gap, arm_qpos)
 
         if self.phase == Phase.RELEASE:
-            action = np.zeros(7, np.float32)
-            action[6] = GRIPPER_OPEN
+            action = hold(GRIPPER_OPEN)
             if self.phase_steps >= cfg.release_steps:
                 self._retreat_from = p.copy()
                 self._set(Phase.RETREAT)
@@ -390,9 +396,7 @@ class ScriptedOpener:
                     self._set(Phase.DONE)
             return action
 
-        action = np.zeros(7, np.float32)
-        action[6] = GRIPPER_OPEN
-        return action
+        return hold(GRIPPER_OPEN)
 
     def _start_pull(self, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate) -> None:
         self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
@@ -526,9 +530,7 @@ class ScriptedOpener:
                 # the other way
                 self._other_fingers = True
             self._set(Phase.RELEASE)
-            action = np.zeros(7, np.float32)
-            action[6] = GRIPPER_CLOSE
-            return action
+            return hold(GRIPPER_CLOSE)
         holding = finger_gap is not None and finger_gap >= cfg.hold_gap
         far = np.linalg.norm(p - est.grasp_point) > cfg.slip_distance and not holding
         self._slip_count = self._slip_count + 1 if far else 0
@@ -540,21 +542,17 @@ class ScriptedOpener:
             self.regrasps += int(self._grasp_again)
             self._let_go_state = float(est.state)
             self._set(Phase.RELEASE)
-            action = np.zeros(7, np.float32)
-            action[6] = GRIPPER_OPEN
-            return action
+            return hold(GRIPPER_OPEN)
         if self._slip_count >= cfg.slip_steps and self.regrasps < cfg.max_regrasps:
             self.regrasps += 1
             self._target_r = None
             self._set(Phase.PREGRASP)
-            action = np.zeros(7, np.float32)
-            action[6] = GRIPPER_OPEN
-            return action
+            return hold(GRIPPER_OPEN)
         if revolute:
-            lead = cfg.lid_lift_lead if self._lid and self._lift else cfg.revolute_lead
-            delta = state - self._grasp_state + lead
+            lifting = self._lid and self._lift
+            delta = state - self._grasp_state + (cfg.lid_lift_lead if lifting else cfg.revolute_lead)
             p_des = pivot + axis_angle_matrix(u, delta) @ (self._grasp_p - pivot)
-            if self._lid and self._lift and cfg.lid_lift_inward > 0.0:
+            if lifting and cfg.lid_lift_inward > 0.0:
                 # lifting from below, the fingertips slide towards the hinge as the lid turns: off
                 # the lid's own arc (an estimated hinge a centimetre or two off), they stay under it
                 radial = off_axis(p_des - pivot, u)
