@@ -140,11 +140,15 @@ def extend_cosine_schedule(optimizer: torch.optim.Optimizer,
 
 
 def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume: bool = True,
-          stop_after: int | None = None) -> TrainResult:
+          stop_after: int | None = None, init_from: str | Path | None = None) -> TrainResult:
     """Train ``config.model`` on ``data_dir`` (shard layout of :mod:`perception.data`) into ``out_dir``.
 
     ``resume``: continue from ``out_dir/last.pt`` when present (its model config must match).
     ``stop_after``: run at most this many epochs in this call (time-sliced jobs); a later call resumes.
+    ``init_from``: a checkpoint whose weights start a new run (fine-tuning; its model config must
+    match; the optimizer and learning-rate schedule start fresh). Its validation loss is measured
+    first and it is written as ``best.pt``, so the best checkpoint is never worse than the start.
+    Ignored when the run resumes from ``last.pt`` (which already descends from it).
     """
     config.validate()
     out = Path(out_dir)
@@ -179,10 +183,22 @@ def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume
         start_epoch = int(ckpt.extra["epoch"]) + 1
         best_val = float(ckpt.extra["best_val"])
         torch.set_rng_state(ckpt.extra["torch_rng"])
-    elif log_path.exists():
-        log_path.unlink()
+    else:
+        if log_path.exists():
+            log_path.unlink()
+        if init_from is not None:
+            model.load_state_dict(load_checkpoint(init_from, expected_model=mcfg).state_dict)
+            if len(val_ds):
+                val_loader = DataLoader(val_ds, batch_size=config.batch_size, shuffle=False,
+                                        num_workers=config.num_workers)
+                best_val = run_epoch(model, val_loader, config, device, None, amp, "val init")["total"]
+                save_checkpoint(best_path, config.model, model.state_dict(), category=category,
+                                training={"train_config": to_dict(config), "data_dir": str(data_dir),
+                                          "init_from": str(init_from), "epoch": -1,
+                                          "val_loss": best_val})
 
-    training_info = {"train_config": to_dict(config), "data_dir": str(data_dir)}
+    training_info = {"train_config": to_dict(config), "data_dir": str(data_dir),
+                     "init_from": None if init_from is None else str(init_from)}
     epoch_bar = tqdm(range(start_epoch, config.epochs), desc="epochs", disable=not config.progress,
                      initial=start_epoch, total=config.epochs)
     for epoch in epoch_bar:
@@ -212,13 +228,18 @@ def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume
         epoch_bar.set_postfix(train=f"{tr['total']:.4f}", val=f"{va['total']:.4f}")
 
     # Choose the voting window with the best weights and store it in both checkpoints.
+    if not best_path.exists():
+        raise RuntimeError(f"no epoch was run and no starting checkpoint was scored: {best_path} is missing")
     best = load_checkpoint(best_path, expected_model=mcfg)
     model.load_state_dict(best.state_dict)
     window = choose_window_on(model, val_ds, config, device)
     save_checkpoint(best_path, config.model, best.state_dict, window, category, best.training)
-    last = load_checkpoint(last_path, expected_model=mcfg)
-    save_checkpoint(last_path, config.model, last.state_dict, window, category, last.training, last.extra)
-    epochs_run = int(last.extra["epoch"]) + 1
+    epochs_run = 0
+    if last_path.exists():  # absent only when a run from ``init_from`` stopped before its first epoch
+        last = load_checkpoint(last_path, expected_model=mcfg)
+        save_checkpoint(last_path, config.model, last.state_dict, window, category, last.training,
+                        last.extra)
+        epochs_run = int(last.extra["epoch"]) + 1
     return TrainResult(best_path, last_path, log_path, best_val, window, epochs_run)
 
 

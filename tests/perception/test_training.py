@@ -66,3 +66,23 @@ def test_resuming_with_more_epochs_replans_the_cosine_schedule(tmp_path, data_di
     for epoch in (2, 3):
         expected = base * (1 + math.cos(math.pi * epoch / 4)) / 2
         assert float(rows[epoch]["lr"]) == pytest.approx(expected, rel=1e-5)  # the CSV keeps 6 digits
+
+
+def test_init_from_starts_a_new_run_from_a_checkpoints_weights(tmp_path, data_dir):
+    from perception.checkpoint import CheckpointError
+
+    start = train(_cfg("capt", 2), data_dir, tmp_path / "start")
+    weights = load_checkpoint(start.best_path).state_dict
+    # no epoch run: best.pt is the starting checkpoint, scored on the validation split
+    held = train(_cfg("capt", 3), data_dir, tmp_path / "held", stop_after=0, init_from=start.best_path)
+    assert held.epochs_run == 0 and 0.0 < held.best_val_loss < float("inf")
+    best = load_checkpoint(held.best_path)
+    assert all(bool((best.state_dict[k] == weights[k]).all()) for k in weights)
+    assert best.training["init_from"] == str(start.best_path)
+    # training on from it: the best validation loss never exceeds the start's
+    tuned = train(_cfg("capt", 3), data_dir, tmp_path / "tuned", init_from=start.best_path)
+    assert tuned.epochs_run == 3 and tuned.best_val_loss <= held.best_val_loss
+    assert load_checkpoint(tuned.last_path).training["init_from"] == str(start.best_path)
+    # a checkpoint of another model configuration is refused, naming what differs
+    with pytest.raises(CheckpointError):
+        train(_cfg("pct_regression", 1), data_dir, tmp_path / "other", init_from=start.best_path)
