@@ -1,0 +1,43 @@
+"""scripts/compare_variants.py: joint means per category, then the mean over categories."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "compare_variants.py"
+
+
+def _load():
+    spec = importlib.util.spec_from_file_location("compare_variants", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _write(path: Path, category: str, rows: dict) -> Path:
+    path.write_text(json.dumps({"summary": {m: {category: s} for m, s in rows.items()}}))
+    return path
+
+
+def test_means_over_joints_then_categories(tmp_path):
+    cv = _load()
+    a = _write(tmp_path / "a.json", "eyeglasses", {
+        "capt": {"dir_med": [1.0, 3.0], "pos_aed": [0.02, 0.04], "state_med": [4.0, 6.0]},
+        "capt_plain": {"dir_med": [2.0, 4.0], "pos_aed": [0.03, 0.05], "state_med": [5.0, 7.0]}})
+    b = _write(tmp_path / "b.json", "drawer_cabinet", {
+        "capt": {"dir_med": [6.0], "pos_aed": [None], "state_med": [0.03]},
+        "capt_plain": {"dir_med": [8.0], "pos_aed": [None], "state_med": [0.05]},
+        "pct_regression": {"dir_med": [9.0], "pos_aed": [None], "state_med": [0.1]}})
+    result = cv.compare([a, b])
+    assert result["methods"] == ["capt", "capt_plain"]  # pct_regression is missing on eyeglasses
+    assert result["categories"]["eyeglasses"]["capt"]["dir_med"] == pytest.approx(2.0)
+    assert result["categories"]["drawer_cabinet"]["capt"]["pos_aed"] is None  # prismatic: no position
+    assert result["mean"]["capt"]["dir_med"] == pytest.approx(4.0)  # (2 + 6) / 2
+    assert result["mean"]["capt"]["pos_aed"] == pytest.approx(0.03)  # eyeglasses only
+    assert result["mean"]["capt_plain"]["state_med"] == pytest.approx((6.0 + 0.05) / 2)
+    table = cv.markdown(result)
+    assert "| mean | capt | 4 | 0.03 |" in table and "| drawer_cabinet | capt | 6 | - |" in table
