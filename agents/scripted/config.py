@@ -71,6 +71,10 @@ class ScriptedOpenerConfig:
     ``settle_window`` steps (a door falling open; one that creeps is grasped again; at most
     ``settle_max_steps``); then it is done if the door fell past ``fall_open_done`` and grasps again
     otherwise (``fall_open_done`` 0: all of this off).
+    A pull of any other revolute part (not a lid) that stalls past ``revolute_stop_above`` rad (the
+    hand's own measure), the fingers still holding and no wrist joint at its limit, has met the part's
+    end stop and is not grasped again (0: off): a side-hinged door whose limit (1.5-2.0 rad) lies short
+    of ``revolute_target`` stalls there, and grasping it again knocked it back towards closed.
     With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
     fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
     estimated hinge) from where the pull began, a circle is fitted to its path about the estimated axis
@@ -128,6 +132,7 @@ class ScriptedOpenerConfig:
     wrist_limit_margin: float = 0.05
     retreat_distance: float = 0.08
     fall_open_done: float = 1.3
+    revolute_stop_above: float = 1.4
     settle_above: float = 0.8
     settle_clearance: float = 0.1
     settle_window: int = 10
@@ -171,6 +176,8 @@ class ScriptedOpenerConfig:
         require(self.max_regrasps >= 0, "max_regrasps must be >= 0")
         require(self.fall_open_done >= 0,
                 f"fall_open_done must be >= 0 rad (0: off), got {self.fall_open_done}")
+        require(self.revolute_stop_above >= 0,
+                f"revolute_stop_above must be >= 0 rad (0: off), got {self.revolute_stop_above}")
         require(self.settle_above >= 0, f"settle_above must be >= 0 rad, got {self.settle_above}")
         require(self.settle_clearance >= 0,
                 f"settle_clearance must be >= 0 m, got {self.settle_clearance}")

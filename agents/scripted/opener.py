@@ -523,6 +523,13 @@ class ScriptedOpener:
             if self._grasp_again and self._lets_fall() and state >= cfg.fall_open_done:
                 # a door that falls open, past fall_open_done: grasping it again pushes it back
                 self._grasp_again = False
+            holding = finger_gap is not None and finger_gap >= cfg.hold_gap
+            if (self._grasp_again and stalled and revolute and not self._lid and holding
+                    and 0.0 < cfg.revolute_stop_above <= state
+                    and not wrist_at_limit(arm_qpos, cfg.wrist_limit_margin)):
+                # held far open and the arm still in range: the part is at its end stop, and
+                # reaching for the handle again would knock it back
+                self._grasp_again = False
             self.regrasps += int(self._grasp_again)
             self._let_go_state = state
             if self._grasp_again and stalled and wrist_at_limit(arm_qpos, cfg.wrist_limit_margin):

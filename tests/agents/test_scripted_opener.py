@@ -322,6 +322,40 @@ def test_a_door_that_stays_where_it_was_let_go_is_grasped_again() -> None:
                 break
         assert opener.phase == Phase.PREGRASP
 
+def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: float) -> ScriptedOpener:
+    """An opener that grasped a closed door on a vertical hinge (+z at y = -0.2 m, handle 0.4 m
+    from it, opening towards -x) and whose hand, fingers ``finger_gap`` m apart, stopped with the
+    door ``state`` rad open."""
+    u, pivot = np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3])
+    closed = JointAxisEstimate("revolute", u, pivot, 0.0, np.array([-0.1, 0.2, 0.3]))
+    rot = grasp_rotation(closed, np.eye(3), cfg)
+    opener = ScriptedOpener(cfg)
+    opener.act_on(closed, _pose(rot, closed.grasp_point))
+    opener._start_pull(closed.grasp_point, rot, closed)
+    turn = axis_angle_matrix(u, state)
+    est = JointAxisEstimate("revolute", u, pivot, state, pivot + turn @ (closed.grasp_point - pivot))
+    at = _pose(turn @ rot, est.grasp_point)
+    for _ in range(cfg.stall_steps + 2):
+        opener.act_on(est, at, finger_gap=finger_gap)
+        if opener.phase != Phase.PULL:
+            break
+    assert opener.phase == Phase.RELEASE
+    return opener
+
+
+def test_a_side_door_held_far_open_that_stalls_is_at_its_stop() -> None:
+    cfg = ScriptedOpenerConfig()
+    far = cfg.revolute_stop_above + 0.1  # short of revolute_target: a door whose limit comes first
+    assert far < cfg.revolute_target
+    opener = _side_door_stalled_at(far, cfg, finger_gap=0.02)
+    assert not opener._grasp_again and opener.regrasps == 0
+    # nearer closed, with the fingers closed on nothing, or with the option off: grasp again
+    for state, gap, config in ((cfg.revolute_stop_above - 0.3, 0.02, cfg), (far, 0.0, cfg),
+                               (far, 0.02, ScriptedOpenerConfig(revolute_stop_above=0.0))):
+        opener = _side_door_stalled_at(state, config, finger_gap=gap)
+        assert opener._grasp_again and opener.regrasps == 1, (state, gap)
+
+
 def test_doors_and_drawers_are_not_lids() -> None:
     cfg = ScriptedOpenerConfig()
     door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]), 0.0,
@@ -385,6 +419,8 @@ def test_bad_opener_config_is_rejected() -> None:
         from_dict(ScriptedOpenerConfig, {"wrist_limit_margin": -0.1})
     with pytest.raises(ConfigError, match="fall_open_done"):
         from_dict(ScriptedOpenerConfig, {"fall_open_done": -1.0})
+    with pytest.raises(ConfigError, match="revolute_stop_above"):
+        from_dict(ScriptedOpenerConfig, {"revolute_stop_above": -0.5})
     with pytest.raises(ConfigError, match="settle_window"):
         from_dict(ScriptedOpenerConfig, {"settle_window": 0})
 
