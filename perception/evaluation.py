@@ -64,15 +64,20 @@ def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg
 def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str = "test",
              device: str = "cpu", timing_clouds: int = 100, max_samples: int | None = None,
              progress: bool = True) -> EvaluationResult:
-    """Evaluate each checkpoint on ``split``; method name = the checkpoint's model variant. Timing is the
-    median of ``predict`` latency over at least ``timing_clouds`` single-cloud calls (cycling over the
-    split if it is smaller), after 3 warm-up calls."""
+    """Evaluate each checkpoint on ``split``. The method name is the checkpoint's model variant, or
+    ``"<variant> (<path>)"`` for every checkpoint whose variant is given more than once (e.g. two CAPT
+    checkpoints compared), so no row overwrites another. Timing is the median of ``predict`` latency
+    over at least ``timing_clouds`` single-cloud calls (cycling over the split if it is smaller), after
+    3 warm-up calls."""
+    if len({str(p) for p in checkpoints}) != len(checkpoints):
+        raise ValueError(f"a checkpoint is given twice: {[str(p) for p in checkpoints]}")
+    estimators = [ArticulationEstimator.from_checkpoint(path, device=device) for path in checkpoints]
+    variants = [e.config.model.variant for e in estimators]
     results: list[SampleResult] = []
     median_ms: dict[str, float] = {}
-    for path in checkpoints:
-        est = ArticulationEstimator.from_checkpoint(path, device=device)
+    for path, est, variant in zip(checkpoints, estimators, variants, strict=True):
         cfg = est.config.model
-        method = cfg.variant
+        method = variant if variants.count(variant) == 1 else f"{variant} ({path})"
         ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples)
         samples = [ds.sample(i) for i in range(len(ds))]
         clouds = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]

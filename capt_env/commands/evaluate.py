@@ -49,14 +49,17 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path) -> None:
-    """One picture per checkpoint: the first test cloud coloured by predicted part, axes red/green."""
+    """One picture per checkpoint: the first test cloud coloured by predicted part, axes red/green.
+    Named ``<category>_<variant>.png``, with the checkpoint's position appended (``_2``) when an earlier
+    checkpoint of the same variant already took that name."""
     import numpy as np
 
     from perception.data import CaptShardDataset
     from perception.figures import plot_cloud_with_axes
     from perception.inference import ArticulationEstimator
 
-    for path in checkpoints:
+    taken: set[str] = set()
+    for i, path in enumerate(checkpoints, start=1):
         est = ArticulationEstimator.from_checkpoint(path)
         sample = CaptShardDataset(data, split, est.config.model, augment=False, max_samples=1).sample(0)
         cloud = np.asarray(sample.points, np.float64)[np.asarray(sample.part_labels) >= 0]
@@ -64,6 +67,8 @@ def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path) -> No
         true = [(sample.joint_dirs[k], sample.joint_pivots[k]) for k in range(len(sample.joint_mask))
                 if sample.joint_mask[k]]
         name = f"{sample.category}_{est.config.model.variant}.png"
+        name = name if name not in taken else name.replace(".png", f"_{i}.png")
+        taken.add(name)
         plot_cloud_with_axes(out_dir / name, cloud, pred.part_labels,
                              [(j.direction, j.pivot) for j in pred.joints], true,
                              title=f"{sample.category}, {est.config.model.variant}")

@@ -52,6 +52,15 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     assert all(r.pa is not None for r in ev.results if r.method == "capt")
     assert "| box_revolute | capt |" in ev.table and "| box_revolute | pct_regression | - | - |" in ev.table
 
+    # two checkpoints of one variant (e.g. before and after fine-tuning) keep a row each
+    two = evaluate([resumed.best_path, straight.last_path], data_dir, "test", timing_clouds=3,
+                   progress=False)
+    names = [f"capt ({resumed.best_path})", f"capt ({straight.last_path})"]
+    assert set(two.median_ms) == set(names) and len(two.results) == 8
+    assert all(f"| box_revolute | {n} |" in two.table for n in names)
+    with pytest.raises(ValueError, match="given twice"):
+        evaluate([plain.best_path, plain.best_path], data_dir, "test", progress=False)
+
 
 def test_resuming_with_more_epochs_replans_the_cosine_schedule(tmp_path, data_dir):
     import math
