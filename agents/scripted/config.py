@@ -64,17 +64,19 @@ class ScriptedOpenerConfig:
     with this finger order (oven doors), and grasping again the same way returns it to the same limit.
     A door that gravity opens further once let go (hinged below its grasp point about a non-vertical
     axis and not a lid: an oven door) is not grasped again once the pull ends (stall or slip) past
-    ``fall_open_done`` rad (reaching for the handle of a door near level pushes it back). Let go past
+    ``fall_open_done`` rad by both the hand's measure and the perceived state (reaching for the handle
+    of a door near level pushes it back). Let go past
     ``settle_above`` rad (a door let go nearer closed falls too slowly to wait for), the open hand
     backs off, moves ``settle_clearance`` m beyond the grasp radius about the estimated hinge (out of
     the door's sweep) and waits while the perceived state still rises by ``settle_progress`` rad over
     ``settle_window`` steps (a door falling open; one that creeps is grasped again; at most
     ``settle_max_steps``); then it is done if the door fell past ``fall_open_done`` and grasps again
     otherwise (``fall_open_done`` 0: all of this off).
-    A pull of any other revolute part (not a lid) that stalls past ``revolute_stop_above`` rad (the
-    hand's own measure), the fingers still holding and no wrist joint at its limit, has met the part's
-    end stop and is not grasped again (0: off): a side-hinged door whose limit (1.5-2.0 rad) lies short
-    of ``revolute_target`` stalls there, and grasping it again knocked it back towards closed.
+    A pull of any other revolute part (not a lid, nor a door that falls open) that stalls past
+    ``revolute_stop_above`` rad (the hand's own measure), the fingers still holding and no wrist joint
+    at its limit, has met the part's end stop and is not grasped again (0: off): a side-hinged door
+    whose limit (1.5-2.0 rad) lies short of ``revolute_target`` stalls there, and grasping it again
+    knocked it back towards closed.
     With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
     fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
     estimated hinge) from where the pull began, a circle is fitted to its path about the estimated axis

@@ -520,11 +520,15 @@ class ScriptedOpener:
         if state >= target or stalled or at_limit:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
             self._grasp_again = state < target and not at_limit and self.regrasps < cfg.max_regrasps
-            if self._grasp_again and self._lets_fall() and state >= cfg.fall_open_done:
-                # a door that falls open, past fall_open_done: grasping it again pushes it back
+            if (self._grasp_again and self._lets_fall()
+                    and min(state, float(est.state)) >= cfg.fall_open_done):
+                # a door that falls open, past fall_open_done: grasping it again pushes it back. Both
+                # the hand and the perception must say so: fingers slipping along the handle carry
+                # the hand round the arc ahead of the door (hand 1.6 rad, door 1.0: oven seed 11)
                 self._grasp_again = False
             holding = finger_gap is not None and finger_gap >= cfg.hold_gap
             if (self._grasp_again and stalled and revolute and not self._lid and holding
+                    and not self._lets_fall()
                     and 0.0 < cfg.revolute_stop_above <= state
                     and not wrist_at_limit(arm_qpos, cfg.wrist_limit_margin)):
                 # held far open and the arm still in range: the part is at its end stop, and

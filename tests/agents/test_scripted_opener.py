@@ -226,18 +226,20 @@ def test_doors_that_gravity_opens_are_told_from_lids_side_doors_and_top_hinged_f
         assert not falls_open(est, cfg)
 
 
-def _pull_stalled_at(state: float, cfg: ScriptedOpenerConfig) -> tuple[ScriptedOpener, np.ndarray]:
-    """An opener that grasped the closed falling oven and whose hand stopped with the door ``state``
-    rad open; returns it, released, and the hand's pose (7,)."""
+def _pull_stalled_at(state: float, cfg: ScriptedOpenerConfig, perceived: float | None = None,
+                     finger_gap: float | None = None) -> tuple[ScriptedOpener, np.ndarray]:
+    """An opener that grasped the closed falling oven and whose hand stopped where the handle is with
+    the door ``state`` rad open (perceived ``perceived`` rad open; default: ``state``); returns it,
+    released, and the hand's pose (7,)."""
     closed = _falling_oven(0.0)
     rot = grasp_rotation(closed, np.eye(3), cfg)
     opener = ScriptedOpener(cfg)
     opener.act_on(closed, _pose(rot, closed.grasp_point))
     opener._start_pull(closed.grasp_point, rot, closed)
-    est = _falling_oven(state)
-    at = _pose(rot, est.grasp_point)
+    est = _falling_oven(state if perceived is None else perceived)
+    at = _pose(rot, _falling_oven(state).grasp_point)
     for _ in range(cfg.stall_steps + 2):
-        opener.act_on(est, at)
+        opener.act_on(est, at, finger_gap=finger_gap)
     assert opener.phase == Phase.RELEASE
     for _ in range(cfg.release_steps):
         opener.act_on(est, at)
@@ -265,6 +267,19 @@ def test_a_door_that_falls_open_past_fall_open_done_is_let_go_for_good() -> None
         waited += int(opener._settle is not None)
     # it backed off, cleared the door's sweep and waited for it (still, here) before it was done
     assert opener.phase == Phase.DONE and waited == cfg.settle_window + 1
+
+
+def test_a_hand_that_ran_ahead_of_a_falling_door_does_not_end_the_opening() -> None:
+    # fingers slipping along the handle carried the hand 1.6 rad round the arc, past fall_open_done
+    # and revolute_stop_above, while the door (perceived) is 1.0 rad open: grasp again
+    cfg = ScriptedOpenerConfig()
+    ahead = max(cfg.fall_open_done, cfg.revolute_stop_above) + 0.2
+    assert ahead < cfg.revolute_target
+    opener, _ = _pull_stalled_at(ahead, cfg, perceived=1.0, finger_gap=0.02)
+    assert opener._grasp_again and opener.regrasps == 1
+    # perceived past fall_open_done too: let go for good
+    opener, _ = _pull_stalled_at(ahead, cfg, perceived=cfg.fall_open_done + 0.1, finger_gap=0.02)
+    assert not opener._grasp_again and opener.regrasps == 0
 
 
 def test_a_door_let_go_short_of_open_is_cleared_and_waited_for_while_it_falls() -> None:
