@@ -517,36 +517,33 @@ class ScriptedOpener:
             before = self._pulled[-1 - cfg.stall_steps]
             progress = (swept_angle(u, pivot, before, p) if revolute else float((p - before) @ u))
             stalled = progress < min_progress
+        holding = finger_gap is not None and finger_gap >= cfg.hold_gap
+        falls = self._lets_fall()
         if state >= target or stalled or at_limit:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
             self._grasp_again = state < target and not at_limit and self.regrasps < cfg.max_regrasps
-            if (self._grasp_again and self._lets_fall()
-                    and min(state, float(est.state)) >= cfg.fall_open_done):
+            wrist_stuck = stalled and wrist_at_limit(arm_qpos, cfg.wrist_limit_margin)
+            if falls and min(state, float(est.state)) >= cfg.fall_open_done:
                 # a door that falls open, past fall_open_done: grasping it again pushes it back. Both
                 # the hand and the perception must say so: fingers slipping along the handle carry
                 # the hand round the arc ahead of the door (hand 1.6 rad, door 1.0: oven seed 11)
                 self._grasp_again = False
-            holding = finger_gap is not None and finger_gap >= cfg.hold_gap
-            if (self._grasp_again and stalled and revolute and not self._lid and holding
-                    and not self._lets_fall()
-                    and 0.0 < cfg.revolute_stop_above <= state
-                    and not wrist_at_limit(arm_qpos, cfg.wrist_limit_margin)):
+            if (stalled and revolute and not self._lid and not falls and holding and not wrist_stuck
+                    and 0.0 < cfg.revolute_stop_above <= state):
                 # held far open and the arm still in range: the part is at its end stop, and
                 # reaching for the handle again would knock it back
                 self._grasp_again = False
             self.regrasps += int(self._grasp_again)
             self._let_go_state = state
-            if self._grasp_again and stalled and wrist_at_limit(arm_qpos, cfg.wrist_limit_margin):
+            if self._grasp_again and wrist_stuck:
                 # the arm ran out of range with this finger order: the other one turns the wrist
                 # the other way
                 self._other_fingers = True
             self._set(Phase.RELEASE)
             return hold(GRIPPER_CLOSE)
-        holding = finger_gap is not None and finger_gap >= cfg.hold_gap
         far = np.linalg.norm(p - est.grasp_point) > cfg.slip_distance and not holding
         self._slip_count = self._slip_count + 1 if far else 0
-        if (self._slip_count >= cfg.slip_steps and self._lets_fall()
-                and est.state >= cfg.settle_above):
+        if self._slip_count >= cfg.slip_steps and falls and est.state >= cfg.settle_above:
             # off the handle of a door that falls open: let go, clear it and wait (see RETREAT)
             # instead of reaching for a handle on the move; past fall_open_done it is left open
             self._grasp_again = est.state < cfg.fall_open_done and self.regrasps < cfg.max_regrasps
