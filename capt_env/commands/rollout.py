@@ -4,9 +4,14 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import asdict
+from typing import TYPE_CHECKING
 
 from capt_env.commands.json_output import write_json
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
+from perception.yaml_config import to_dict
+
+if TYPE_CHECKING:
+    from agents.scripted.config import ScriptedOpenerConfig
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -21,13 +26,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
     parser.add_argument("--every-k-steps", type=int, default=5, help="perception period in env steps")
     parser.add_argument("--max-steps", type=int, default=200)
+    parser.add_argument("--opener", default=None,
+                        help="YAML of ScriptedOpenerConfig overrides (with --policy scripted), e.g. "
+                             "configs/opener/steep_door_approach.yaml; default: the opener's defaults")
     add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
 
 
+def opener_config(path: str | None) -> ScriptedOpenerConfig:
+    """The scripted opener's config: its defaults, overridden by the keys of YAML ``path`` (unknown
+    keys and bad values exit with a message naming them)."""
+    from agents.scripted.config import ScriptedOpenerConfig
+    from perception.yaml_config import ConfigError, load_yaml
+
+    if path is None:
+        return ScriptedOpenerConfig()
+    try:
+        return load_yaml(ScriptedOpenerConfig, path)
+    except ConfigError as err:
+        raise SystemExit(f"--opener {path}: {err}") from err
+
+
 def _policy(args: argparse.Namespace, category: str) -> tuple[object, str | None]:
-    """The policy to evaluate and its model file: the scripted opener (None), or a trained PPO model
-    (``--model``, else the category's shipped one)."""
+    """The policy to evaluate and its model file: the scripted opener (None; ``--opener`` overrides
+    its config), or a trained PPO model (``--model``, else the category's shipped one)."""
     if args.policy == "ppo":
         from agents.ppo.policies import shipped_policy
         from agents.ppo.policy import PPOPolicy
@@ -39,7 +61,7 @@ def _policy(args: argparse.Namespace, category: str) -> tuple[object, str | None
         return PPOPolicy.load(model), str(model)
     from agents.scripted.opener import ScriptedOpener
 
-    return ScriptedOpener(), None
+    return ScriptedOpener(opener_config(args.opener)), None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -53,6 +75,10 @@ def run(args: argparse.Namespace) -> int:
     rows, lines = [], [header, "| --- | --- | --- | --- | --- | --- | --- |"]
     seeds = list(range(args.first_seed, args.first_seed + args.episodes))
     task = task_overrides(args.task)
+    if args.opener is not None and args.policy != "scripted":
+        raise SystemExit("--opener configures the scripted policy; a PPO policy runs the opener "
+                         "recorded with it")
+    opener = to_dict(opener_config(args.opener)) if args.policy == "scripted" else None
     for category in args.categories:
         for source in args.perception:
             wrapper = {"source": source, "every_k_steps": args.every_k_steps}
@@ -87,5 +113,6 @@ def run(args: argparse.Namespace) -> int:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
         Path(args.markdown).write_text(table + "\n")
     write_json(args.json, {"seeds": seeds, "policy": args.policy, "max_steps": args.max_steps,
-                           "every_k_steps": args.every_k_steps, "task": task, "results": rows})
+                           "every_k_steps": args.every_k_steps, "task": task, "opener": opener,
+                           "results": rows})
     return 0

@@ -56,6 +56,35 @@ def test_rollout_task_overrides_load_and_reject_a_category(tmp_path: Path) -> No
         task_overrides(str(bad))
 
 
+def test_rollout_opener_overrides_load_and_name_a_bad_key(tmp_path: Path) -> None:
+    from capt_env.commands.rollout import opener_config
+
+    repo = Path(__file__).resolve().parents[2]
+    for path in sorted((repo / "configs" / "opener").glob("*.yaml")):
+        assert opener_config(str(path)) != opener_config(None)  # each changes something
+    assert opener_config(str(repo / "configs/opener/steep_door_approach.yaml")).vertical_hinge_pitch == 1.0
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("vertical_hinge_pich: 1.0\n")
+    with pytest.raises(SystemExit, match="vertical_hinge_pich"):
+        opener_config(str(bad))
+    bad.write_text("approach_gap: 0.2\n")
+    with pytest.raises(SystemExit, match="approach_gap"):
+        opener_config(str(bad))
+    with pytest.raises(SystemExit, match="--opener"):
+        main(["rollout", "--policy", "ppo", "--opener", str(bad), "--episodes", "1"])
+
+
+def test_rollout_records_the_opener_it_ran(tmp_path: Path) -> None:
+    out = tmp_path / "rollout.json"
+    repo = Path(__file__).resolve().parents[2]
+    assert main(["rollout", "--categories", "cabinet_door", "--episodes", "1", "--max-steps", "3",
+                 "--opener", str(repo / "configs/opener/steep_door_approach.yaml"),
+                 "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["opener"]["vertical_hinge_pitch"] == 1.0 and data["opener"]["approach_pitch"] == 0.55
+    assert data["results"][0]["episodes"][0]["steps"] == 3
+
+
 def test_demo_estimates_an_unseen_object_with_the_shipped_checkpoint(tmp_path: Path) -> None:
     """The main job's estimation half: shipped checkpoint, two cameras, an accurate axis and a PNG."""
     out = tmp_path / "demo.json"
