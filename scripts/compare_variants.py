@@ -2,8 +2,10 @@
 
 Each input file is one `capt evaluate` run that scored the three variants side by side on one
 category's test split. Prints, per category and as the mean over categories, the mean direction
-error (degrees), position error (normalised object frame) and state error (degrees; metres for
-prismatic joints), each first averaged over the category's joints.
+error (degrees), position error (normalised object frame), and state error, in degrees over revolute
+joints and in metres over prismatic ones (never averaged together), each first averaged over the
+category's joints. A joint without a position error is prismatic (``capt evaluate`` reports none for
+them). A mean over no value (e.g. position when every category is prismatic) is "-".
 
     .venv/bin/python scripts/compare_variants.py benchmarks/perception_laptop.json \
         benchmarks/perception_oven.json --markdown benchmarks/variants_mean.md \
@@ -17,13 +19,28 @@ import json
 import statistics
 from pathlib import Path
 
-METRICS = (("dir_med", "direction (deg)"), ("pos_aed", "position (normalised)"), ("state_med", "state"))
+METRICS = (("dir_med", "direction (deg)"), ("pos_aed", "position (normalised)"),
+           ("state_deg", "state, revolute (deg)"), ("state_m", "state, prismatic (m)"))
 
 
 def joint_mean(values: list[float | None]) -> float | None:
     """Mean over a category's joints, skipping joints without the metric (prismatic position)."""
     present = [v for v in values if v is not None]
     return statistics.fmean(present) if present else None
+
+
+def category_errors(s: dict) -> dict[str, float | None]:
+    """One method's joint means on one category from its ``capt evaluate`` summary ``s``; the state
+    is split by joint type (a joint with no position error is prismatic)."""
+    revolute = [p is not None for p in s["pos_aed"]]
+    return {"dir_med": joint_mean(s["dir_med"]), "pos_aed": joint_mean(s["pos_aed"]),
+            "state_deg": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if r]),
+            "state_m": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if not r])}
+
+
+def category_mean(values: list[float | None]) -> float | None:
+    """Mean over categories of the values that exist; None when none does."""
+    return joint_mean(values)
 
 
 def compare(paths: list[Path]) -> dict:
@@ -33,12 +50,12 @@ def compare(paths: list[Path]) -> dict:
         summary = json.loads(path.read_text())["summary"]
         for method, cats in summary.items():
             for cat, s in cats.items():
-                per_cat.setdefault(cat, {})[method] = {m: joint_mean(s[m]) for m, _ in METRICS}
+                per_cat.setdefault(cat, {})[method] = category_errors(s)
     methods = sorted(set.intersection(*(set(v) for v in per_cat.values())))
     if not methods:
         raise SystemExit("no method was evaluated on every category")
-    mean = {m: {k: statistics.fmean(per_cat[c][m][k] for c in per_cat if per_cat[c][m][k] is not None)
-                for k, _ in METRICS} for m in methods}
+    mean = {m: {k: category_mean([per_cat[c][m][k] for c in per_cat]) for k, _ in METRICS}
+            for m in methods}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths]}
 
 

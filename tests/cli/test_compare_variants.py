@@ -38,6 +38,22 @@ def test_means_over_joints_then_categories(tmp_path):
     assert result["categories"]["drawer_cabinet"]["capt"]["pos_aed"] is None  # prismatic: no position
     assert result["mean"]["capt"]["dir_med"] == pytest.approx(4.0)  # (2 + 6) / 2
     assert result["mean"]["capt"]["pos_aed"] == pytest.approx(0.03)  # eyeglasses only
-    assert result["mean"]["capt_plain"]["state_med"] == pytest.approx((6.0 + 0.05) / 2)
+    # degrees and metres are never averaged together
+    assert result["mean"]["capt_plain"]["state_deg"] == pytest.approx(6.0)  # eyeglasses only
+    assert result["mean"]["capt_plain"]["state_m"] == pytest.approx(0.05)  # the drawer only
+    assert result["categories"]["eyeglasses"]["capt"]["state_m"] is None
     table = cv.markdown(result)
-    assert "| mean | capt | 4 | 0.03 |" in table and "| drawer_cabinet | capt | 6 | - |" in table
+    assert "| mean | capt | 4 | 0.03 | 5 | 0.03 |" in table
+    assert "| drawer_cabinet | capt | 6 | - | - | 0.03 |" in table
+
+
+def test_a_category_with_both_joint_types_and_an_all_prismatic_set(tmp_path):
+    cv = _load()
+    mixed = _write(tmp_path / "m.json", "kitchen", {
+        "capt": {"dir_med": [2.0, 4.0], "pos_aed": [0.02, None], "state_med": [6.0, 0.1]}})
+    row = cv.compare([mixed])["categories"]["kitchen"]["capt"]
+    assert row["state_deg"] == pytest.approx(6.0) and row["state_m"] == pytest.approx(0.1)
+    drawers = _write(tmp_path / "d.json", "drawer_cabinet", {
+        "capt": {"dir_med": [6.0], "pos_aed": [None], "state_med": [0.03]}})
+    mean = cv.compare([drawers])["mean"]["capt"]
+    assert mean["pos_aed"] is None and mean["state_deg"] is None and mean["state_m"] == pytest.approx(0.03)
