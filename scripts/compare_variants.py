@@ -24,7 +24,8 @@ METRICS = (("dir_med", "direction (deg)"), ("pos_aed", "position (normalised)"),
 
 
 def joint_mean(values: list[float | None]) -> float | None:
-    """Mean over a category's joints, skipping joints without the metric (prismatic position)."""
+    """Mean of the values that exist (over a category's joints, skipping joints without the metric,
+    or over categories); None when none does."""
     present = [v for v in values if v is not None]
     return statistics.fmean(present) if present else None
 
@@ -38,11 +39,6 @@ def category_errors(s: dict) -> dict[str, float | None]:
             "state_m": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if not r])}
 
 
-def category_mean(values: list[float | None]) -> float | None:
-    """Mean over categories of the values that exist; None when none does."""
-    return joint_mean(values)
-
-
 def compare(paths: list[Path]) -> dict:
     """{"methods": [...], "categories": {cat: {method: {metric: value}}}, "mean": {method: {...}}}."""
     per_cat: dict[str, dict[str, dict[str, float | None]]] = {}
@@ -54,7 +50,7 @@ def compare(paths: list[Path]) -> dict:
     methods = sorted(set.intersection(*(set(v) for v in per_cat.values())))
     if not methods:
         raise SystemExit("no method was evaluated on every category")
-    mean = {m: {k: category_mean([per_cat[c][m][k] for c in per_cat]) for k, _ in METRICS}
+    mean = {m: {k: joint_mean([per_cat[c][m][k] for c in per_cat]) for k, _ in METRICS}
             for m in methods}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths]}
 

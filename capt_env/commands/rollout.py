@@ -47,9 +47,10 @@ def opener_config(path: str | None) -> ScriptedOpenerConfig:
         raise SystemExit(f"--opener {path}: {err}") from err
 
 
-def _policy(args: argparse.Namespace, category: str) -> tuple[object, str | None]:
-    """The policy to evaluate and its model file: the scripted opener (None; ``--opener`` overrides
-    its config), or a trained PPO model (``--model``, else the category's shipped one)."""
+def _policy(args: argparse.Namespace, category: str,
+            opener: ScriptedOpenerConfig | None) -> tuple[object, str | None]:
+    """The policy to evaluate and its model file: the scripted opener with config ``opener`` (None),
+    or a trained PPO model (``--model``, else the category's shipped one)."""
     if args.policy == "ppo":
         from agents.ppo.policies import shipped_policy
         from agents.ppo.policy import PPOPolicy
@@ -61,7 +62,7 @@ def _policy(args: argparse.Namespace, category: str) -> tuple[object, str | None
         return PPOPolicy.load(model), str(model)
     from agents.scripted.opener import ScriptedOpener
 
-    return ScriptedOpener(opener_config(args.opener)), None
+    return ScriptedOpener(opener), None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -78,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
     if args.opener is not None and args.policy != "scripted":
         raise SystemExit("--opener configures the scripted policy; a PPO policy runs the opener "
                          "recorded with it")
-    opener = to_dict(opener_config(args.opener)) if args.policy == "scripted" else None
+    opener = opener_config(args.opener) if args.policy == "scripted" else None
     for category in args.categories:
         for source in args.perception:
             wrapper = {"source": source, "every_k_steps": args.every_k_steps}
@@ -89,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
                 obs_mode = "pointcloud"
             env = make_env(category, wrapper, task=task, obs_mode=obs_mode)
-            policy, model = _policy(args, category)
+            policy, model = _policy(args, category, opener)
             try:
                 episodes = [run_episode(env, policy, s, args.max_steps)
                             for s in tqdm(seeds, desc=f"{category} {source}")]
@@ -113,6 +114,7 @@ def run(args: argparse.Namespace) -> int:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
         Path(args.markdown).write_text(table + "\n")
     write_json(args.json, {"seeds": seeds, "policy": args.policy, "max_steps": args.max_steps,
-                           "every_k_steps": args.every_k_steps, "task": task, "opener": opener,
+                           "every_k_steps": args.every_k_steps, "task": task,
+                           "opener": None if opener is None else to_dict(opener),
                            "results": rows})
     return 0
