@@ -182,17 +182,23 @@ class CaptSource:
                         model: Any, k: int,
                         direction: np.ndarray) -> tuple[PartPlane | None, np.ndarray | None]:
         """(front plane, k-th handle from the bottom among ``geometry`` points) of a stack of
-        prismatic parts, or (None, None) when the model has fewer than two prismatic joints, the
-        front is not flat or does not face along the slide ``direction``, or fewer than k + 1
-        handles are in view."""
+        prismatic parts, or (None, None) when the model has fewer than two prismatic joints, neither
+        the stacked parts together nor the target alone are flat and face along the slide
+        ``direction``, or fewer than k + 1 handles are in view."""
         stacked = [int(c) for c, t in zip(model.joint_child_parts, model.joint_types, strict=False)
                    if t == "prismatic"]
         if len(stacked) < 2:
             return None, None
-        front = points[np.isin(np.asarray(result.part_labels), stacked)]
+        labels = np.asarray(result.part_labels)
+        front = points[np.isin(labels, stacked)]
         plane = part_plane(points, front)
         if not faces_along(plane, direction):
-            return None, None
+            # the union is not flat when CAPT gave a drawer some of the carcass's top or side (drawer
+            # seed 108, three drawers): the target's own front is the stack's front plane too
+            front = points[labels == int(model.joint_child_parts[k])]
+            plane = part_plane(points, front)
+            if not faces_along(plane, direction):
+                return None, None
         handle = kth_handle_from_bottom(geometry, front, k, plane=plane, min_points=min_points)
         return (plane, handle) if handle is not None else (None, None)
 

@@ -54,3 +54,45 @@ def test_a_drawer_slides_along_its_front_normal(slide_along_front: bool, max_err
     assert min_error_deg <= error <= max_error_deg
     assert est.joint_type == "prismatic"
     np.testing.assert_allclose(est.grasp_point, [-0.23, 0.0, 0.3], atol=0.01)  # the handle
+
+
+def _three_drawer_cloud(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A cabinet facing -x with three 0.12 m drawers stacked from z = 0.03 (front plane x = 0, bars
+    3 cm out at z = 0.09, 0.21, 0.33), labelled 1, 2, 3 bottom up, and its top and sides labelled 3
+    as well (CAPT giving the top drawer some of the carcass, drawer seed 108): the drawers together
+    are not flat, the bottom drawer alone is. World frame, metres."""
+    parts, labels = [], []
+    for i, z in enumerate((0.03, 0.15, 0.27)):
+        parts.append(np.column_stack([np.zeros(300), rng.uniform(-0.2, 0.2, 300),
+                                      rng.uniform(z, z + 0.12, 300)]))
+        parts.append(np.column_stack([np.full(40, -0.03), rng.uniform(-0.06, 0.06, 40),
+                                      np.full(40, z + 0.06)]))
+        labels += [i + 1] * 340
+    top = np.column_stack([rng.uniform(0.0, 0.4, 600), rng.uniform(-0.2, 0.2, 600), np.full(600, 0.39)])
+    side = np.column_stack([rng.uniform(0.0, 0.4, 500), np.full(500, 0.2), rng.uniform(0.03, 0.39, 500)])
+    parts += [top, side]
+    labels += [3] * 1100
+    points = np.concatenate(parts) + rng.normal(0.0, 0.001, (2120, 3))
+    return points, np.asarray(labels)
+
+
+class _StackNetwork:
+    """Three prismatic joints sliding along -x, with the given part labels."""
+
+    def __init__(self, labels: np.ndarray) -> None:
+        self.labels = labels
+        model = SimpleNamespace(joint_child_parts=(1, 2, 3), joint_types=("prismatic",) * 3)
+        self.config = SimpleNamespace(model=model)
+
+    def predict(self, points: np.ndarray) -> ArticulationEstimate:
+        joints = tuple(JointEstimate(k, "prismatic", np.array([-1.0, 0.0, 0.0]),
+                                     np.array([0.0, 0.0, 0.09 + 0.12 * k]), 0.0, 0.9) for k in range(3))
+        return ArticulationEstimate(self.labels, joints, 1.0)
+
+
+def test_the_bottom_drawer_is_found_when_the_segmented_stack_is_not_flat() -> None:
+    points, labels = _three_drawer_cloud(np.random.default_rng(0))
+    source = CaptSource("unused.pt", order_stacked_parts=True, slide_along_front=True)
+    source._estimator = _StackNetwork(labels)
+    est = source.estimate(points, {"target_joint": np.array([0])})
+    np.testing.assert_allclose(est.grasp_point, [-0.03, 0.0, 0.09], atol=0.015)  # not between two bars

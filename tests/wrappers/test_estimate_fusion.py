@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from capt_env.wrappers.estimate import JointAxisEstimate
 from capt_env.wrappers.estimate_fusion import EstimateFusion
@@ -29,6 +30,44 @@ def test_pivot_and_grasp_are_weighted_means_until_the_part_moves() -> None:
     moved = fusion.update(est([0, 0, 1], [0.0, 0.06, 0.0], state=0.4, grasp=(0.2, 0.2, 0.2)))
     np.testing.assert_allclose(moved.grasp_point, [0.2, 0.2, 0.2])  # the part moved: latest grasp
     assert moved.state == 0.4
+
+
+def drawer(state: float, grasp) -> JointAxisEstimate:
+    return JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.array([0.1, -0.05, 0.09]),
+                             state, np.asarray(grasp, float), 1.0)
+
+
+def test_a_handle_left_behind_by_the_moving_part_is_not_trusted() -> None:
+    """Drawer seed 143: as the drawer slid 0.2 m open, the handle search stayed on the cabinet's
+    front where the drawer had been (x = 0.11); the handle is where the slide carried it."""
+    fusion = EstimateFusion()
+    for _ in range(3):
+        fusion.update(drawer(0.0, (0.10, -0.05, 0.09)), from_handle=True)
+    stuck = fusion.update(drawer(0.2, (0.11, -0.05, 0.07)), from_handle=True)
+    np.testing.assert_allclose(stuck.grasp_point, [-0.10, -0.05, 0.09], atol=1e-9)
+    # a look where the handle went is trusted again, and later looks are checked against it
+    found = fusion.update(drawer(0.21, (-0.12, -0.05, 0.09)), from_handle=True)
+    np.testing.assert_allclose(found.grasp_point, [-0.12, -0.05, 0.09])
+    again = fusion.update(drawer(0.22, (0.11, -0.05, 0.07)), from_handle=True)
+    np.testing.assert_allclose(again.grasp_point, [-0.13, -0.05, 0.09], atol=1e-9)
+
+
+def test_the_handle_check_scales_with_the_part_travel() -> None:
+    """A look 6 cm off where the handle should be, after a 0.3 m slide (the estimated state is a few
+    centimetres noisy), is still the handle; right after a 6 cm slide it is not."""
+    fusion = EstimateFusion()
+    fusion.update(drawer(0.0, (0.10, -0.05, 0.09)))
+    far = fusion.update(drawer(0.3, (-0.14, -0.05, 0.09)))
+    np.testing.assert_allclose(far.grasp_point, [-0.14, -0.05, 0.09])
+    fusion.reset()
+    fusion.update(drawer(0.0, (0.10, -0.05, 0.09)))
+    near = fusion.update(drawer(0.06, (0.10, -0.05, 0.09)))
+    np.testing.assert_allclose(near.grasp_point, [0.04, -0.05, 0.09], atol=1e-9)
+
+
+def test_bad_fusion_settings_are_refused() -> None:
+    with pytest.raises(ValueError, match="handle_jump_m"):
+        EstimateFusion(handle_jump_m=0.0)
 
 
 def test_reset_forgets() -> None:
