@@ -5,9 +5,9 @@ estimate of its axis is another noisy look at the same line. The fused axis is t
 mean of the directions (each sign-aligned with the running mean); its sign is the weighted vote of
 the estimates' own signs (each set by geometry, so one bad first look cannot fix the sign for the
 episode). The pivot, and the grasp point while the part has not moved (state within
-``state_tolerance`` of the first estimate), are weighted means of the estimates for up to two of them and
-coordinate-wise weighted medians from three on, so one grasp point found on the wrong part is
-outvoted. Once the part moves, the latest grasp point is used. The state is always the latest
+``state_tolerance`` of the first estimate), are weighted means of the estimates for up to two of
+them and coordinate-wise weighted medians from three on, so one grasp point found on the wrong part
+is outvoted. Once the part moves, the latest grasp point is used. The state is always the latest
 estimate.
 
 An estimate whose grasp point was found on a handle (``from_handle``) is worth more than one whose

@@ -56,24 +56,27 @@ def test_a_drawer_slides_along_its_front_normal(slide_along_front: bool, max_err
     np.testing.assert_allclose(est.grasp_point, [-0.23, 0.0, 0.3], atol=0.01)  # the handle
 
 
-def _three_drawer_cloud(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """A cabinet facing -x with three 0.12 m drawers stacked from z = 0.03 (front plane x = 0, bars
-    3 cm out at z = 0.09, 0.21, 0.33), labelled 1, 2, 3 bottom up, and its top and sides labelled 3
-    as well (CAPT giving the top drawer some of the carcass, drawer seed 108): the drawers together
-    are not flat, the bottom drawer alone is. World frame, metres."""
+def _three_drawer_cloud(rng: np.random.Generator, bars: tuple[int, int, int] = (40, 40, 40),
+                        front: int = 300,
+                        carcass_as_top_drawer: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """A cabinet facing -x with three 0.12 m drawers stacked from z = 0.03 (front plane x = 0,
+    ``front`` points each, bars 3 cm out at z = 0.09, 0.21, 0.33 with ``bars`` points), labelled 1,
+    2, 3 bottom up, and its top and side: labelled 3 too with ``carcass_as_top_drawer`` (CAPT giving
+    the top drawer some of the carcass, drawer seed 108: the drawers together are not flat, the
+    bottom drawer alone is), else 0. World frame, metres."""
     parts, labels = [], []
-    for i, z in enumerate((0.03, 0.15, 0.27)):
-        parts.append(np.column_stack([np.zeros(300), rng.uniform(-0.2, 0.2, 300),
-                                      rng.uniform(z, z + 0.12, 300)]))
-        parts.append(np.column_stack([np.full(40, -0.03), rng.uniform(-0.06, 0.06, 40),
-                                      np.full(40, z + 0.06)]))
-        labels += [i + 1] * 340
+    for i, (z, n) in enumerate(zip((0.03, 0.15, 0.27), bars, strict=True)):
+        parts.append(np.column_stack([np.zeros(front), rng.uniform(-0.2, 0.2, front),
+                                      rng.uniform(z, z + 0.12, front)]))
+        parts.append(np.column_stack([np.full(n, -0.03), rng.uniform(-0.06, 0.06, n),
+                                      np.full(n, z + 0.06)]))
+        labels += [i + 1] * (front + n)
     top = np.column_stack([rng.uniform(0.0, 0.4, 600), rng.uniform(-0.2, 0.2, 600), np.full(600, 0.39)])
     side = np.column_stack([rng.uniform(0.0, 0.4, 500), np.full(500, 0.2), rng.uniform(0.03, 0.39, 500)])
     parts += [top, side]
-    labels += [3] * 1100
-    points = np.concatenate(parts) + rng.normal(0.0, 0.001, (2120, 3))
-    return points, np.asarray(labels)
+    labels += [3 if carcass_as_top_drawer else 0] * 1100
+    points = np.concatenate(parts)
+    return points + rng.normal(0.0, 0.001, points.shape), np.asarray(labels)
 
 
 class _StackNetwork:
@@ -96,3 +99,16 @@ def test_the_bottom_drawer_is_found_when_the_segmented_stack_is_not_flat() -> No
     source._estimator = _StackNetwork(labels)
     est = source.estimate(points, {"target_joint": np.array([0])})
     np.testing.assert_allclose(est.grasp_point, [-0.03, 0.0, 0.09], atol=0.015)  # not between two bars
+
+
+def test_a_low_handle_with_few_points_still_counts_in_a_stack() -> None:
+    """Drawer seed 30: the bottom drawer's bar showed 26 dense points where a lone handle needs 48,
+    so the stack's lowest handle was the middle drawer's. Dense points 4x the model's input: a
+    lone handle needs 12, one in a stack a quarter of that; the bottom bar has 8."""
+    dense, labels = _three_drawer_cloud(np.random.default_rng(1), bars=(8, 160, 160), front=1200,
+                                        carcass_as_top_drawer=False)
+    keep = np.random.default_rng(2).permutation(len(dense))[: len(dense) // 4]
+    source = CaptSource("unused.pt", order_stacked_parts=True, dense_geometry=True, slide_along_front=True)
+    source._estimator = _StackNetwork(labels[keep])
+    est = source.estimate(dense[keep], {"target_joint": np.array([0])}, dense_points=dense)
+    np.testing.assert_allclose(est.grasp_point, [-0.03, 0.0, 0.09], atol=0.015)
