@@ -87,15 +87,12 @@ class EstimateFusion:
         vote = sum(wi * float(np.sign(di @ direction)) for wi, di in self._signed)
         if vote < 0:
             direction = -direction
-        if (from_handle and moved and estimate.joint_type == "prismatic"
-                and self._handle_grasp is not None and self._pivots):
+        if from_handle and moved and estimate.joint_type == "prismatic" and self._handle_grasp is not None:
             handle, handle_state = self._handle_grasp
-            expected = moved_with_part(handle, estimate.joint_type, direction,
-                                       robust_centre(*_trusted(self._pivots)), state - handle_state)
-            travel = float(np.linalg.norm(expected - handle))
-            if float(np.linalg.norm(latest - expected)) > max(self.handle_jump_m,
-                                                              self.handle_jump_share * travel):
-                from_handle = False  # not where the part carried its handle: something else
+            slide = state - handle_state
+            if float(np.linalg.norm(latest - (handle + slide * direction))) > max(
+                    self.handle_jump_m, self.handle_jump_share * abs(slide)):
+                from_handle = False  # not where the slide carried its handle: something else
         self._pivots.append((np.asarray(estimate.pivot, dtype=np.float64), w, from_handle))
         line_point = robust_centre(*_trusted(self._pivots))
         if from_handle:
