@@ -64,6 +64,7 @@ from agents.scripted.geometry import (
     rotation_error,
     swept_angle,
 )
+from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
 from capt_env.wrappers.estimate import JointAxisEstimate, unit
 from capt_env.wrappers.joint_observation import decode_observation
 
@@ -260,6 +261,7 @@ class ScriptedOpener:
         self._let_go_state = 0.0  # the part's state (rad or m) when a pull last let go of it
         self._settle: list[float] | None = None  # perceived states while waiting for a falling part
         self._other_fingers = False  # the next grasp turns the fingers the other way round
+        self.rehearsals: tuple[Rehearsal, Rehearsal] | None = None  # the last finger-order rehearsal
         self._still = 0
         self._last_p: np.ndarray | None = None
         self._last_err = (0.0, 0.0)
@@ -314,6 +316,8 @@ class ScriptedOpener:
         if self.phase in (Phase.PREGRASP, Phase.APPROACH):
             if self._target_r is None or self.phase == Phase.PREGRASP and self.phase_steps == 1:
                 self._target_r = grasp_rotation(est, r, cfg)
+                if cfg.rehearse_fingers and arm_qpos is not None and not is_lid(est, cfg):
+                    self._target_r = self._rehearsed_fingers(est, p, r, arm_qpos, self._target_r)
                 if self._other_fingers:
                     self._target_r = self._target_r @ _SWAP_FINGERS
                     self._other_fingers = False
@@ -397,6 +401,50 @@ class ScriptedOpener:
             return action
 
         return hold(GRIPPER_OPEN)
+
+    def _rehearse(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray, arm_qpos: np.ndarray,
+                  rotation: np.ndarray) -> Rehearsal:
+        """Grasp and pull with TCP ``rotation`` (3, 3) rehearsed on the arm's kinematic model."""
+        cfg = self.cfg
+        approach = rotation[:, 2]
+        point = est.grasp_point
+        grasp = point + approach * cfg.grasp_depth
+        u = unit(est.direction)
+        path: list[tuple[np.ndarray, np.ndarray]] = []
+        if est.joint_type == "revolute":
+            follow = 1.0 if is_vertical_hinge(est, cfg) else cfg.wrist_follow
+            for delta in np.arange(0.05, max(cfg.revolute_target - float(est.state), 0.0) + 1e-9, 0.05):
+                path.append((est.pivot + axis_angle_matrix(u, delta) @ (grasp - est.pivot),
+                             axis_angle_matrix(u, follow * delta) @ rotation))
+        else:
+            for delta in np.arange(0.01, max(cfg.prismatic_target - float(est.state), 0.0) + 1e-9, 0.01):
+                path.append((grasp + u * delta, rotation))
+        tcp = np.eye(4)
+        tcp[:3, :3], tcp[:3, 3] = r, p
+        return rehearse(arm_qpos, tcp, rotation, point - approach * cfg.pregrasp_offset, grasp, path,
+                        max_step_m=cfg.max_step_m, max_step_rad=cfg.max_step_rad,
+                        rotate_first_above=cfg.rotate_first_above,
+                        rotate_first_steps=cfg.rotate_first_steps, move_timeout=cfg.move_timeout,
+                        pos_tolerance=cfg.pos_tolerance, rot_tolerance=cfg.rot_tolerance,
+                        pull_tolerance_m=cfg.rehearse_track_m)
+
+    def _rehearsed_fingers(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
+                           arm_qpos: np.ndarray, nearer: np.ndarray) -> np.ndarray:
+        """``nearer`` (3, 3), or the same approach with the fingers swapped if the rehearsal says the
+        arm reaches and pulls clearly better that way (see ``rehearse_fingers`` in the config)."""
+        cfg = self.cfg
+        other = nearer @ _SWAP_FINGERS
+
+        def reaches(x: Rehearsal) -> bool:
+            return x.grasp_error_m <= 2 * cfg.pos_tolerance and x.grasp_error_rad <= 2 * cfg.rot_tolerance
+
+        a = self._rehearse(est, p, r, arm_qpos, nearer)
+        b = self._rehearse(est, p, r, arm_qpos, other)
+        self.rehearsals = (a, b)
+        if reaches(b) and b.pull_share >= 1.0 and (
+                not reaches(a) or a.pull_share <= 1.0 - cfg.rehearse_margin):
+            return other
+        return nearer
 
     def _start_pull(self, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate) -> None:
         self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state

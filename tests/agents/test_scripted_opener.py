@@ -19,6 +19,7 @@ from agents.scripted.opener import (
     lift_pose,
     outward_normal,
 )
+from agents.scripted.panda_kinematics import tcp_pose
 from agents.scripted.rollout import make_env, run_episode
 from capt_env.wrappers.estimate import JointAxisEstimate
 from perception.yaml_config import ConfigError, from_dict
@@ -455,6 +456,29 @@ def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
     # and not for ever: after rotate_first_steps steps it travels and turns together
     opener = ScriptedOpener(ScriptedOpenerConfig(rotate_first_steps=0))
     assert np.abs(opener.act_on(drawer, down)[:3]).max() > 0.1
+
+
+def test_the_finger_order_the_wrist_cannot_reach_is_rehearsed_and_not_taken() -> None:
+    # the hand points down with joint 7 turned 1.8 rad from where the TCP's x is world +x: of the two
+    # finger orders for a straight-down grasp (x = +x or -x), the nearer one (1.34 rad) needs joint 7
+    # at 3.94 rad, past its 2.90 limit; the farther one (1.8 rad the other way) brings it back to 0.8
+    q = np.array([0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 2.6])
+    tcp = tcp_pose(q)  # the base at the world origin
+    lift = JointAxisEstimate("prismatic", np.array([0.0, 0.0, 1.0]), tcp[:3, 3] - [0, 0, 0.15], 0.0,
+                             tcp[:3, 3] - [0, 0, 0.15])
+    pose = np.concatenate([tcp[:3, 3], Rotation.from_matrix(tcp[:3, :3]).as_quat(scalar_first=True)])
+    plain = ScriptedOpener(ScriptedOpenerConfig(rehearse_fingers=False, prismatic_target=0.1))
+    plain.act_on(lift, pose, finger_gap=0.06, arm_qpos=q)
+    assert plain._target_r[:, 0] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(-1.0, abs=1e-6)
+    rehearsed = ScriptedOpener(ScriptedOpenerConfig(prismatic_target=0.1))
+    rehearsed.act_on(lift, pose, finger_gap=0.06, arm_qpos=q)
+    nearer, other = rehearsed.rehearsals
+    assert nearer.grasp_error_rad > 2 * 0.12 and other.pull_share == 1.0
+    assert rehearsed._target_r[:, 0] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(1.0, abs=1e-6)
+    # without the arm's joint angles there is nothing to rehearse: the nearer order
+    blind = ScriptedOpener(ScriptedOpenerConfig(prismatic_target=0.1))
+    blind.act_on(lift, pose)
+    assert blind.rehearsals is None and np.allclose(blind._target_r, plain._target_r)
 
 
 @pytest.mark.parametrize(("category", "seed", "max_steps"), [
