@@ -19,6 +19,9 @@ Strategy, per episode:
    horizontal by at least ``vertical_hinge_pitch`` (doors) or ``approach_pitch`` (other parts), as
    the Panda's wrist cannot point level near the table. A lid (its grasp point opens upwards) is
    gripped from above, the fingers closing along the hinge across its front lip (``is_lid``).
+   Of the two finger orders the one nearer the hand's rotation is taken, unless a rehearsal on the
+   arm's kinematic model says only the other reaches the grasp and holds it through the pull
+   (``rehearse_fingers``; :mod:`agents.scripted.grasp_rehearsal`).
 2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper. If a
    lid's fingers closed on nothing (its lip is wider than the open fingers), the hand backs off and
    lifts the lid from below instead (:func:`lift_pose`): fingers closed, pointing at the hinge and
