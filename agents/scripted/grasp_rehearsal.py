@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from agents.scripted.geometry import axis_angle_matrix, clip_norm
-from agents.scripted.panda_kinematics import base_in_world, ik_step, pose_error, tcp_pose
+from agents.scripted.panda_kinematics import base_in_world, ik_step, pose_error, pose_matrix, tcp_pose
 
 
 @dataclass(frozen=True)
@@ -29,13 +29,6 @@ class Rehearsal:
     grasp_error_m: float
     grasp_error_rad: float
     pull_share: float
-
-
-def _pose(position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    pose = np.eye(4)
-    pose[:3, :3] = rotation
-    pose[:3, 3] = position
-    return pose
 
 
 class _Arm:
@@ -56,8 +49,7 @@ class _Arm:
         err = pose_error(self.world_to_base @ goal_in_world, tcp)
         dp = np.zeros(3) if turn_only else clip_norm(err[:3], self.max_step_m)
         dr = clip_norm(err[3:], self.max_step_rad)
-        target = _pose(tcp[:3, 3] + dp, axis_angle_matrix(dr, 1.0) @ tcp[:3, :3]
-                       if np.linalg.norm(dr) > 0 else tcp[:3, :3])
+        target = pose_matrix(tcp[:3, 3] + dp, axis_angle_matrix(dr, 1.0) @ tcp[:3, :3])
         self.q = ik_step(self.q, target)
 
     def move(self, goal_in_world: np.ndarray, max_steps: int, pos_tolerance: float,
@@ -81,17 +73,17 @@ def rehearse(arm_qpos: np.ndarray, tcp_in_world: np.ndarray, rotation: np.ndarra
     out, ``steps_per_waypoint`` control steps each), from the arm's joint angles ``arm_qpos`` (7,) rad
     and its TCP pose ``tcp_in_world`` (4, 4). The caps, tolerances and timeouts are the opener's."""
     arm = _Arm(arm_qpos, tcp_in_world, max_step_m, max_step_rad)
-    pregrasp_goal = _pose(pregrasp, rotation)
+    pregrasp_goal = pose_matrix(pregrasp, rotation)
     for _ in range(rotate_first_steps):
         if arm.error(pregrasp_goal)[1] <= rotate_first_above:
             break
         arm.step(pregrasp_goal, turn_only=True)
     arm.move(pregrasp_goal, move_timeout, pos_tolerance, rot_tolerance)
-    grasp_goal = _pose(grasp, rotation)
+    grasp_goal = pose_matrix(grasp, rotation)
     grasp_m, grasp_rad = arm.move(grasp_goal, move_timeout, pos_tolerance, rot_tolerance)
     followed = 0
     for position, rot in pull_path:
-        goal = _pose(position, rot)
+        goal = pose_matrix(position, rot)
         for _ in range(steps_per_waypoint):
             arm.step(goal)
         if arm.error(goal)[0] > pull_tolerance_m:

@@ -68,6 +68,7 @@ from agents.scripted.geometry import (
     swept_angle,
 )
 from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
+from agents.scripted.panda_kinematics import PANDA_LOWER, PANDA_UPPER, pose_matrix
 from capt_env.wrappers.estimate import JointAxisEstimate, unit
 from capt_env.wrappers.joint_observation import decode_observation
 
@@ -80,8 +81,7 @@ ACTION_SCALE_RAD = -0.1
 _UP = np.array([0.0, 0.0, 1.0])
 _SWAP_FINGERS = np.diag([-1.0, -1.0, 1.0])  # the same approach with the fingers the other way round
 # the Panda's wrist joints 5, 6 and 7 (rad), from its URDF
-_WRIST_LOWER = np.array([-2.8973, -0.0175, -2.8973])
-_WRIST_UPPER = np.array([2.8973, 3.7525, 2.8973])
+_WRIST_LOWER, _WRIST_UPPER = PANDA_LOWER[4:], PANDA_UPPER[4:]
 # ManiSkill's Panda gripper maps action [-1, 1] linearly to each finger's position [-0.01, 0.04] m.
 _FINGER_LOW, _FINGER_HIGH = -0.01, 0.04
 
@@ -422,9 +422,8 @@ class ScriptedOpener:
         else:
             for delta in np.arange(0.01, max(cfg.prismatic_target - float(est.state), 0.0) + 1e-9, 0.01):
                 path.append((grasp + u * delta, rotation))
-        tcp = np.eye(4)
-        tcp[:3, :3], tcp[:3, 3] = r, p
-        return rehearse(arm_qpos, tcp, rotation, point - approach * cfg.pregrasp_offset, grasp, path,
+        pregrasp = point - approach * cfg.pregrasp_offset
+        return rehearse(arm_qpos, pose_matrix(p, r), rotation, pregrasp, grasp, path,
                         max_step_m=cfg.max_step_m, max_step_rad=cfg.max_step_rad,
                         rotate_first_above=cfg.rotate_first_above,
                         rotate_first_steps=cfg.rotate_first_steps, move_timeout=cfg.move_timeout,

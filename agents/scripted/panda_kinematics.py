@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from agents.scripted.geometry import rotation_error
+
 # (a m, d m, alpha rad) of joints 1..7 (theta = q_i), then the flange (theta = 0)
 _DH = np.array([
     [0.0, 0.333, 0.0],
@@ -26,6 +28,14 @@ _TCP_OFFSET = 0.1034  # m, from the hand's origin along its z (between the finge
 
 PANDA_LOWER = np.array([-2.8973, -1.7628, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973])
 PANDA_UPPER = np.array([2.8973, 1.7628, 2.8973, -0.0698, 2.8973, 3.7525, 2.8973])
+
+
+def pose_matrix(position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """Homogeneous pose (4, 4) from a position (3,) m and a rotation (3, 3)."""
+    pose = np.eye(4)
+    pose[:3, :3] = rotation
+    pose[:3, 3] = position
+    return pose
 
 
 def _dh(a: float, d: float, alpha: float, theta: float) -> np.ndarray:
@@ -88,24 +98,10 @@ def base_in_world(q: np.ndarray, tcp_in_world: np.ndarray) -> np.ndarray:
     return tcp_in_world @ np.linalg.inv(tcp_pose(q))
 
 
-def _rotvec(r: np.ndarray) -> np.ndarray:
-    """Rotation vector (3,) of rotation matrix ``r`` (3, 3), radians (angle below pi)."""
-    cos = float(np.clip((np.trace(r) - 1.0) / 2.0, -1.0, 1.0))
-    angle = float(np.arccos(cos))
-    w = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    if angle < 1e-6:
-        return 0.5 * w
-    if np.pi - angle < 1e-4:  # near a half turn: the axis is the column of r + I with the largest norm
-        m = r + np.eye(3)
-        axis = m[:, int(np.argmax(np.linalg.norm(m, axis=0)))]
-        return angle * axis / np.linalg.norm(axis)
-    return angle * w / (2.0 * np.sin(angle))
-
-
 def pose_error(target: np.ndarray, current: np.ndarray) -> np.ndarray:
     """(6,) position error (m) and rotation vector (rad) taking ``current`` (4, 4) to ``target`` (4, 4),
     both in the same frame."""
-    return np.concatenate([target[:3, 3] - current[:3, 3], _rotvec(target[:3, :3] @ current[:3, :3].T)])
+    return np.concatenate([target[:3, 3] - current[:3, 3], rotation_error(target[:3, :3], current[:3, :3])])
 
 
 def ik_step(q: np.ndarray, target: np.ndarray, iterations: int = 3, damping: float = 0.05) -> np.ndarray:

@@ -16,6 +16,7 @@ from agents.scripted.panda_kinematics import (
     ik_step,
     jacobian,
     pose_error,
+    pose_matrix,
     tcp_pose,
 )
 from agents.scripted.rollout import make_env
@@ -24,13 +25,7 @@ from capt_env.wrappers.joint_observation import decode_observation
 _HOME = np.array([0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 0.8])  # near ManiSkill's reset pose, hand down
 
 
-def _pose(position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    pose = np.eye(4)
-    pose[:3, :3], pose[:3, 3] = rotation, position
-    return pose
-
-
-def test_the_model_puts_the_base_where_the_simulator_has_it_in_any_arm_pose() -> None:
+def test_the_model_puts_the_base_where_the_simulator_has_it_in_any_armpose_matrix() -> None:
     # the base is fixed: every (joint angles, simulated TCP pose) pair must give the same base pose
     env = make_env("oven", {"source": "oracle"}, obs_mode="state")
     rng = np.random.default_rng(0)
@@ -39,7 +34,7 @@ def test_the_model_puts_the_base_where_the_simulator_has_it_in_any_arm_pose() ->
     for _ in range(12):
         proprio, _ = decode_observation(obs)
         q = np.asarray(proprio["qpos"]).reshape(-1)[:7]
-        tcp = _pose(np.asarray(proprio["tcp_pose"][:3]), quat_to_matrix(proprio["tcp_pose"][3:7]))
+        tcp = pose_matrix(np.asarray(proprio["tcp_pose"][:3]), quat_to_matrix(proprio["tcp_pose"][3:7]))
         bases.append(base_in_world(q, tcp))
         obs, *_ = env.step(rng.uniform(-1.0, 1.0, 7).astype(np.float32))
     env.close()
@@ -72,7 +67,7 @@ def test_ik_reaches_a_nearby_pose_and_keeps_the_joints_in_their_limits() -> None
     at_limit = _HOME.copy()
     at_limit[6] = PANDA_UPPER[6] - 0.05
     start = tcp_pose(at_limit)
-    beyond = _pose(start[:3, 3], start[:3, :3] @ axis_angle_matrix(np.array([0.0, 0.0, 1.0]), 1.5))
+    beyond = pose_matrix(start[:3, 3], start[:3, :3] @ axis_angle_matrix(np.array([0.0, 0.0, 1.0]), 1.5))
     q = at_limit
     for _ in range(20):
         q = ik_step(q, beyond)
