@@ -19,7 +19,13 @@ class ScriptedOpenerConfig:
     it starts nearer level); a level Panda hand near the table is beyond its wrist limits. The hand first
     turns in place to the grasp orientation while it is more than ``rotate_first_above`` rad from it, for
     at most ``rotate_first_steps`` steps (turned while travelling, the arm's IK reaches a low, far handle
-    with the wrist at its joint limit and cannot hold the pose while pulling; 0 steps: never). The fingers
+    with the wrist at its joint limit and cannot hold the pose while pulling; 0 steps: never). The grasp
+    orientation is chosen as the pre-grasp move starts and chosen again, the move starting over, when
+    in the first ``rechoose_steps`` steps of the grasp's pre-grasp the perceived grasp point is more
+    than ``rechoose_grasp_m`` m from the one it was chosen for (0: never): a first look that finds no
+    handle puts the grasp point on the part's far edge, and an orientation chosen for that point does
+    not suit the handle seen a few steps later (not later on: an open part's grasp point jumps about
+    from look to look, and each start over turns the hand first). The fingers
     approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched fingertip
     off the surface a handle stands on, but under 6 cm a finger pitched across a drawer's bar clips its
     edge when the grasp point is half a centimetre off). Moves are capped at ``max_step_m`` /
@@ -103,6 +109,8 @@ class ScriptedOpenerConfig:
     vertical_hinge_max_tilt: float = 0.8
     rotate_first_above: float = 0.4
     rotate_first_steps: int = 25
+    rechoose_grasp_m: float = 0.05
+    rechoose_steps: int = 30
     max_step_m: float = 0.03
     max_step_rad: float = 0.15
     pos_tolerance: float = 0.012
@@ -171,6 +179,9 @@ class ScriptedOpenerConfig:
         require(self.rehearse_track_m > 0, f"rehearse_track_m must be > 0 m, got {self.rehearse_track_m}")
         require(self.rotate_first_above > 0,
                 f"rotate_first_above must be > 0 rad, got {self.rotate_first_above}")
+        require(self.rechoose_grasp_m >= 0,
+                f"rechoose_grasp_m must be >= 0 m (0: never), got {self.rechoose_grasp_m}")
+        require(self.rechoose_steps >= 0, f"rechoose_steps must be >= 0, got {self.rechoose_steps}")
         require(self.rotate_first_steps >= 0,
                 f"rotate_first_steps must be >= 0 (0: never), got {self.rotate_first_steps}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",

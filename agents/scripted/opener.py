@@ -251,6 +251,9 @@ class ScriptedOpener:
         self._grasp_state = 0.0
         self._grasp_u: np.ndarray | None = None
         self._target_r: np.ndarray | None = None
+        self._target_for: np.ndarray | None = None  # the grasp point _target_r was chosen for
+        self._swap_this_grasp = False  # this grasp turns the fingers the other way round
+        self._pregrasp_steps = 0  # steps this grasp has spent in PREGRASP, moves started over included
         self._lid = False
         self._lift = False
         self._history: list[float] = []
@@ -283,6 +286,13 @@ class ScriptedOpener:
         self.phase_steps = 0
         self._still = 0
         self._last_p = None
+
+    def _grasp_point_moved(self, est: JointAxisEstimate) -> bool:
+        """Whether ``est``'s grasp point is more than ``rechoose_grasp_m`` m from the one the grasp
+        orientation was chosen for (False before one is chosen or with ``rechoose_grasp_m`` 0)."""
+        if self.cfg.rechoose_grasp_m <= 0 or self._target_r is None or self._target_for is None:
+            return False
+        return float(np.linalg.norm(est.grasp_point - self._target_for)) > self.cfg.rechoose_grasp_m
 
     def _reached(self, p: np.ndarray, perr: float, rerr: float) -> bool:
         """A move ends at the goal, on timeout, or when blocked (TCP still for ``blocked_steps``)."""
@@ -317,13 +327,23 @@ class ScriptedOpener:
         self.phase_steps += 1
 
         if self.phase in (Phase.PREGRASP, Phase.APPROACH):
+            if self.phase == Phase.PREGRASP:
+                self._pregrasp_steps += 1
+                if (self._pregrasp_steps <= cfg.rechoose_steps and self._grasp_point_moved(est)):
+                    # a different grasp point: choose again and start the move over (early in the
+                    # move only: a part seen open jumps about from look to look, and each start over
+                    # turns the hand first)
+                    self.phase_steps = 1
             if self._target_r is None or self.phase == Phase.PREGRASP and self.phase_steps == 1:
+                if self._target_r is None:  # a new grasp (not a new choice for this one)
+                    self._swap_this_grasp, self._other_fingers = self._other_fingers, False
+                    self._pregrasp_steps = 1
                 self._target_r = grasp_rotation(est, r, cfg)
                 if cfg.rehearse_fingers and arm_qpos is not None and not is_lid(est, cfg):
                     self._target_r = self._rehearsed_fingers(est, p, r, arm_qpos, self._target_r)
-                if self._other_fingers:
+                if self._swap_this_grasp:
                     self._target_r = self._target_r @ _SWAP_FINGERS
-                    self._other_fingers = False
+                self._target_for = np.array(est.grasp_point, dtype=np.float64)
                 self._lid = is_lid(est, cfg)
             lift = lift_pose(est, r, cfg, self.phase) if self._lift else None
             if lift is not None:

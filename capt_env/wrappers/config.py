@@ -91,7 +91,11 @@ class PerceptionWrapperConfig:
     a few of those, kept by one draw and lost by the next). ``slide_along_front`` (``capt`` only): a
     prismatic estimate slides along the normal of its part's flat front (a plane fitted to hundreds
     of points) when that front faces within 0.6 rad of CAPT's direction; off, the direction is
-    CAPT's own, only its sign set by the front.
+    CAPT's own, only its sign set by the front. ``panel_max_state`` (``capt`` only, rad, 0 off):
+    while CAPT's state of a revolute joint is under it (the part is about closed), the hinge edge is
+    looked for on the whole flat panel the moving part lies on (its in-plane points joined to it:
+    ``moving_part_geometry.coplanar_panel``), not only on the points CAPT labels as moving (it can
+    label the handle's half of a door only).
     """
 
     source: Source = "oracle"
@@ -106,10 +110,13 @@ class PerceptionWrapperConfig:
     order_stacked_parts: bool = True
     dense_geometry: bool = True
     slide_along_front: bool = True
+    panel_max_state: float = 0.35
 
     def validate(self) -> None:
         require(self.every_k_steps >= 1, f"every_k_steps must be >= 1, got {self.every_k_steps}")
         require(self.num_points >= 32, f"num_points must be >= 32, got {self.num_points}")
+        require(0.0 <= self.panel_max_state <= 3.15,
+                f"panel_max_state must be in [0, pi] rad, got {self.panel_max_state}")
         if self.source == "capt":
             require(self.checkpoint is not None, "source 'capt' needs a checkpoint path")
         self.isolation.validate()

@@ -9,7 +9,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from capt_env.wrappers.estimate import unit
 from capt_env.wrappers.plane_fit import ransac_plane
@@ -45,6 +47,35 @@ def part_plane(object_points: np.ndarray, part_points: np.ndarray) -> PartPlane 
     if float((object_points.mean(axis=0) - centre) @ normal) > 0.0:
         normal = -normal
     return PartPlane(centre, vt[:2], normal)
+
+
+def coplanar_panel(object_points: np.ndarray, part_points: np.ndarray, plane: PartPlane,
+                   band: float = 0.01, link_radius: float = 0.03) -> np.ndarray:
+    """The flat panel a segmented part lies on: the points (K, 3) of ``object_points`` (N, 3) within
+    ``band`` m of ``plane`` and linked to ``part_points`` (M, 3) through in-plane neighbours at most
+    ``link_radius`` m apart, with ``part_points`` themselves. World frame, metres.
+
+    A segmentation can label only the handle's half of a closed door as moving (cabinet door seed 150:
+    16 of its 40 cm); the rest of the door is still in its plane and touches that half, so the
+    panel gives the door's full extent, whose edge away from the handle is the hinge. Only for a
+    closed part: an open door is coplanar with whatever it happens to align with (at 90 deg a
+    cabinet's side wall, joined at the hinge).
+    """
+    obj = np.asarray(object_points, dtype=np.float64)
+    part = np.asarray(part_points, dtype=np.float64)
+    in_band = np.abs((obj - plane.centre) @ plane.outward) <= band
+    if not in_band.any():
+        return part
+    candidates = obj[in_band]
+    uv = (np.concatenate([part, candidates]) - plane.centre) @ plane.in_plane.T
+    pairs = cKDTree(uv).query_pairs(link_radius, output_type="ndarray")
+    if len(pairs) == 0:
+        return part
+    n = len(uv)
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, labels = connected_components(graph, directed=False)
+    linked = np.isin(labels[len(part):], np.unique(labels[:len(part)]))
+    return np.unique(np.concatenate([part, candidates[linked]]), axis=0)
 
 
 def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standoff: float = 0.012,
@@ -182,7 +213,8 @@ def edge_aligned_direction(direction: np.ndarray, plane: PartPlane, part_points:
 
 def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, part_points: np.ndarray,
                   pivot: np.ndarray | None = None, tolerance: float = 0.06,
-                  edge_quantile: float = 0.02, min_aspect: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
+                  edge_quantile: float = 0.02, min_aspect: float = 0.25,
+                  panel_points: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """A flat part's hinge line checked against its points: (unit direction (3,), pivot (3,)), world
     frame, metres.
 
@@ -196,7 +228,9 @@ def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, pa
     direction is kept. A direction more than 60 deg out of the plane is not a hinge of this part,
     and a part whose points spread less than ``min_aspect`` as much across their main in-plane
     direction as along it is a bar (an eyeglasses temple), not a flat panel: then the direction is returned
-    unchanged, with ``pivot`` (or the plane's centre) moved along it.
+    unchanged, with ``pivot`` (or the plane's centre) moved along it. ``panel_points`` (K, 3), when
+    given, replace ``part_points`` for finding the edges (the whole panel the part lies on:
+    :func:`coplanar_panel`); the bar test stays on ``part_points``.
     """
     g = np.asarray(grasp, dtype=np.float64)
     u = unit(direction)
@@ -208,7 +242,8 @@ def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, pa
         return u, base + u * float((g - base) @ u)
     along = unit(along)
     across = unit(np.cross(plane.outward, along))
-    s = (part_points - plane.centre) @ across
+    edges_of = part_points if panel_points is None else panel_points
+    s = (edges_of - plane.centre) @ across
     s_grasp = float((g - plane.centre) @ across)
     lo, hi = np.quantile(s, [edge_quantile, 1.0 - edge_quantile])
     edge = float(lo if abs(s_grasp - lo) > abs(s_grasp - hi) else hi)

@@ -23,6 +23,7 @@ from capt_env.wrappers.estimate import (
 from capt_env.wrappers.estimate_fusion import EstimateFusion
 from capt_env.wrappers.moving_part_geometry import (
     PartPlane,
+    coplanar_panel,
     edge_aligned_direction,
     handle_point,
     hinge_on_edge,
@@ -156,13 +157,14 @@ class CaptSource:
 
     def __init__(self, checkpoint: str, seed: int = 0, hinge_on_part_edge: bool = False,
                  order_stacked_parts: bool = False, dense_geometry: bool = False,
-                 slide_along_front: bool = False) -> None:
+                 slide_along_front: bool = False, panel_max_state: float = 0.0) -> None:
         self.checkpoint = checkpoint
         self.seed = seed
         self.hinge_on_part_edge = hinge_on_part_edge
         self.order_stacked_parts = order_stacked_parts
         self.dense_geometry = dense_geometry
         self.slide_along_front = slide_along_front
+        self.panel_max_state = panel_max_state
         self._estimator: Any = None
         self._fusion = EstimateFusion()
 
@@ -230,14 +232,20 @@ class CaptSource:
             plane = part_plane(points, moving)
             if joint.type == "prismatic" and not faces_along(plane, direction):
                 plane = None  # an open drawer's largest plane is its bottom or a side, not its front
+        panel = moving  # the flat panel the moving part lies on (a closed door's whole front)
         if plane is not None and self.hinge_on_part_edge and joint.type == "revolute":
+            if abs(float(joint.state)) < self.panel_max_state:
+                panel = coplanar_panel(points, moving, plane)
+            # the part's own points, not the panel: rectangles fitted to the panel turned the line
+            # 5-11 deg off during pulls (CAPT's state lags, so the panel was grown on a door already
+            # 0.4-0.6 rad open): cabinet door seeds 153, 178 and 181 failed with it, opened without
             direction = edge_aligned_direction(direction, plane, moving)
         if grasp is None and plane is not None:
             # a bar is centred across its thickness too (the cameras see one side of it, where the
             # points' centroid sits), except on a part swinging about a horizontal hinge (an oven
             # door, a lid): measured, that moved an oven's grasp point off its bar
             across = joint.type == "prismatic" or abs(float(direction[2])) >= _VERTICAL_HINGE_MIN_Z
-            grasp = handle_point(geometry, moving, plane=plane, min_points=min_points,
+            grasp = handle_point(geometry, panel, plane=plane, min_points=min_points,
                                  centre_across=across)
         from_handle = grasp is not None
         if plane is not None and joint.type == "prismatic":
@@ -252,7 +260,8 @@ class CaptSource:
             grasp = grasp_point_of_part(moving, joint.type, direction, np.asarray(joint.pivot))
         pivot = canonical_pivot(direction, np.asarray(joint.pivot, dtype=np.float64), grasp)
         if plane is not None and self.hinge_on_part_edge and joint.type == "revolute":
-            direction, pivot = hinge_on_edge(direction, grasp, plane, moving, pivot=pivot)
+            direction, pivot = hinge_on_edge(direction, grasp, plane, moving, pivot=pivot,
+                                             panel_points=panel)
         if plane is not None and joint.type == "revolute":
             direction = opening_direction(joint.type, direction, pivot, grasp, plane.outward)
         return self._fusion.update(JointAxisEstimate(joint.type, direction, pivot, float(joint.state),
@@ -261,7 +270,8 @@ class CaptSource:
 
 def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: int,
                 hinge_on_part_edge: bool = False, order_stacked_parts: bool = False,
-                dense_geometry: bool = False, slide_along_front: bool = False) -> PerceptionSource:
+                dense_geometry: bool = False, slide_along_front: bool = False,
+                panel_max_state: float = 0.0) -> PerceptionSource:
     """The source named ``source`` ("oracle", "noisy_oracle", "capt")."""
     if source == "oracle":
         return OracleSource()
@@ -271,5 +281,5 @@ def make_source(source: str, noise: NoiseConfig, checkpoint: str | None, seed: i
         if checkpoint is None:
             raise ValueError("source 'capt' needs a checkpoint path")
         return CaptSource(checkpoint, seed, hinge_on_part_edge, order_stacked_parts, dense_geometry,
-                          slide_along_front)
+                          slide_along_front, panel_max_state)
     raise ValueError(f"unknown perception source {source!r}")

@@ -51,7 +51,8 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.config = cfg
         self.source: PerceptionSource = make_source(cfg.source, cfg.noise, cfg.checkpoint, cfg.seed,
                                                      cfg.hinge_on_part_edge, cfg.order_stacked_parts,
-                                                     cfg.dense_geometry, cfg.slide_along_front)
+                                                     cfg.dense_geometry, cfg.slide_along_front,
+                                                     cfg.panel_max_state)
         obs_mode = getattr(env.unwrapped, "obs_mode", None)
         if self.source.needs_points and obs_mode != "pointcloud":
             raise ValueError(

@@ -439,6 +439,8 @@ def test_bad_opener_config_is_rejected() -> None:
         from_dict(ScriptedOpenerConfig, {"revolute_stop_above": -0.5})
     with pytest.raises(ConfigError, match="settle_window"):
         from_dict(ScriptedOpenerConfig, {"settle_window": 0})
+    with pytest.raises(ConfigError, match="rechoose_grasp_m"):
+        from_dict(ScriptedOpenerConfig, {"rechoose_grasp_m": -0.01})
 
 
 def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
@@ -456,6 +458,44 @@ def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
     # and not for ever: after rotate_first_steps steps it travels and turns together
     opener = ScriptedOpener(ScriptedOpenerConfig(rotate_first_steps=0))
     assert np.abs(opener.act_on(drawer, down)[:3]).max() > 0.1
+
+
+def test_the_grasp_orientation_is_chosen_again_for_a_grasp_point_seen_elsewhere() -> None:
+    # a first look finds no handle and puts the grasp point on a far edge; the next finds the handle
+    # 30 cm away, on a door whose approach is steeper (vertical hinge): the orientation follows it
+    first = JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.zeros(3), 0.0,
+                              np.array([0.1, -0.15, 0.2]))
+    handle = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([0.1, -0.2, 0.2]), 0.0,
+                               np.array([0.1, 0.15, 0.2]))
+    away = np.array([-0.2, 0.0, 0.4, 0.0, 1.0, 0.0, 0.0])  # TCP above the part, pointing down (wxyz)
+    r = Rotation.from_quat(away[3:], scalar_first=True).as_matrix()
+    for rechoose, expected in ((0.05, grasp_rotation(handle, r, ScriptedOpenerConfig())),
+                               (0.0, grasp_rotation(first, r, ScriptedOpenerConfig()))):
+        opener = ScriptedOpener(ScriptedOpenerConfig(rechoose_grasp_m=rechoose))
+        for _ in range(5):
+            opener.act_on(first, away)
+        assert opener.phase == Phase.PREGRASP and opener.phase_steps == 5
+        opener.act_on(handle, away)
+        np.testing.assert_allclose(opener._target_r, expected, atol=1e-9)
+        assert opener.phase_steps == (1 if rechoose > 0 else 6)  # the move starts over
+    # late in the pre-grasp move (an open part's grasp point jumps about) it is not chosen again
+    opener = ScriptedOpener(ScriptedOpenerConfig(rechoose_steps=5))
+    for _ in range(5):
+        opener.act_on(first, away)
+    opener.act_on(handle, away)
+    np.testing.assert_allclose(opener._target_r, grasp_rotation(first, r, ScriptedOpenerConfig()),
+                               atol=1e-9)
+    assert not np.allclose(grasp_rotation(handle, r, ScriptedOpenerConfig()),
+                           grasp_rotation(first, r, ScriptedOpenerConfig()), atol=0.1)
+    # a grasp point that moved less than rechoose_grasp_m keeps the orientation and the move
+    opener = ScriptedOpener(ScriptedOpenerConfig())
+    opener.act_on(handle, away)
+    chosen = opener._target_r.copy()
+    nearby = JointAxisEstimate("revolute", handle.direction, handle.pivot, 0.0,
+                               handle.grasp_point + [0.0, 0.03, 0.0])
+    opener.act_on(nearby, away)
+    np.testing.assert_allclose(opener._target_r, chosen)
+    assert opener.phase_steps == 2
 
 
 def test_the_finger_order_the_wrist_cannot_reach_is_rehearsed_and_not_taken() -> None:

@@ -26,6 +26,7 @@ CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "wrappers"
         ({"isolation": {"workspace_min": [1, 0, 0], "workspace_max": [0, 1, 1]}}, "workspace"),
         ({"isolation": {"outlier_k": 0}}, "outlier_k"),
         ({"every_k": 2}, "every_k"),
+        ({"panel_max_state": -0.1}, "panel_max_state"),
     ],
 )
 def test_bad_values_raise_config_error(data: dict, needle: str) -> None:

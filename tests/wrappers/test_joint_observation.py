@@ -16,6 +16,7 @@ from capt_env.wrappers.joint_observation import (
 )
 from capt_env.wrappers.moving_part_geometry import (
     bar_centre,
+    coplanar_panel,
     edge_aligned_direction,
     handle_point,
     hinge_on_edge,
@@ -223,6 +224,29 @@ def test_hinge_on_edge_moves_a_far_off_line_onto_the_door_edge_away_from_the_han
     u, pivot = hinge_on_edge(np.array([0.0, 0.0, 1.0]), grasp, plane, bar, pivot=given_pivot)
     np.testing.assert_allclose(u, [0.0, 0.0, 1.0])
     np.testing.assert_allclose(pivot, [0.05, -0.1, 0.35], atol=1e-9)
+
+
+def test_the_panel_of_a_half_segmented_door_gives_the_hinge_on_its_far_edge() -> None:
+    rng = np.random.default_rng(5)
+    cloud, door = _oven_like_scene(rng, with_handle=True)
+    # a coplanar patch 10 cm beside the door (not joined to it) and points 2 cm behind its plane
+    patch = np.stack([np.zeros(60), rng.uniform(0.3, 0.4, 60), rng.uniform(0.0, 0.4, 60)], axis=1)
+    behind = np.stack([np.full(60, 0.02), rng.uniform(-0.2, 0.2, 60), rng.uniform(0.0, 0.4, 60)], axis=1)
+    cloud = np.concatenate([cloud, patch, behind])
+    # CAPT labelled only the handle's half of a door hinged at y = -0.2 (handle near y = +0.18)
+    labelled = door[door[:, 1] > 0.05]
+    plane = part_plane(cloud, labelled)
+    assert plane is not None
+    panel = coplanar_panel(cloud, labelled, plane)
+    assert len(panel) == len(door)  # the whole door, neither the patch nor the points behind
+    np.testing.assert_allclose(panel[:, 1].min(), door[:, 1].min())
+    grasp = np.array([-0.03, 0.18, 0.2])
+    _, pivot = hinge_on_edge(np.array([0.0, 0.0, -1.0]), grasp, plane, labelled)
+    assert pivot[1] > 0.0  # on the labelled half's own edge: mid-door, 25 cm from the hinge
+    _, pivot = hinge_on_edge(np.array([0.0, 0.0, -1.0]), grasp, plane, labelled, panel_points=panel)
+    np.testing.assert_allclose(pivot[:2], [0.0, -0.2], atol=0.02)
+    # a part with no other points in its plane is its own panel
+    assert len(coplanar_panel(labelled, labelled, plane)) == len(labelled)
 
 
 def test_a_handle_a_sparse_draw_loses_is_found_among_all_points() -> None:
