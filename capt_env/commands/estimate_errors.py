@@ -2,7 +2,8 @@
 
 ``capt evaluate`` scores the network on dataset clouds; this scores what a policy is given: the
 observation wrapper's estimate (object isolation, CAPT, the handle and axis-sign geometry and, when
-on, the hinge put on the moving part's edge) on freshly reset test-split scenes, world frame.
+on, the hinge put on the moving part's edge, found on the part's coplanar panel) on freshly reset
+test-split scenes, world frame.
 Errors per reset: the signed direction error (degrees; a flipped axis counts as ~180), the
 distance between the estimated and true axis lines (revolute joints only, metres) and the grasp
 point's distance to the true one (metres).
@@ -11,12 +12,14 @@ point's distance to the true one (metres).
 from __future__ import annotations
 
 import argparse
+import itertools
 from typing import Any
 
 import numpy as np
 
 from capt_env.commands.json_output import write_json
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
+from capt_env.wrappers.config import PerceptionWrapperConfig
 from capt_env.wrappers.estimate import JointAxisEstimate
 
 
@@ -33,6 +36,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--slide-along-front", default="on", choices=["both", "on", "off"],
                         help="slide a prismatic estimate along its part's front normal (on), keep "
                              "CAPT's direction (off), or score both")
+    parser.add_argument("--coplanar-panel", default="on", choices=["both", "on", "off"],
+                        help="look for a closed part's hinge edge and handle on the whole flat panel "
+                             "it lies on (on: the wrapper's default panel_max_state), only on CAPT's "
+                             "moving points (off: panel_max_state 0), or score both")
     add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
 
@@ -82,33 +89,37 @@ def run(args: argparse.Namespace) -> int:
     if args.resets < 1:
         raise SystemExit(f"--resets must be >= 1, got {args.resets}")
     choices = {"both": [False, True], "on": [True], "off": [False]}
-    flags = [(hinge, dense, front) for hinge in choices[args.hinge_on_part_edge]
-             for dense in choices[args.dense_geometry] for front in choices[args.slide_along_front]]
+    switches = ("hinge_on_part_edge", "dense_geometry", "slide_along_front", "coplanar_panel")
+    combos = [dict(zip(switches, values, strict=True)) for values in itertools.product(
+        *(choices[getattr(args, name)] for name in switches))]
+    panel_on = PerceptionWrapperConfig().panel_max_state
     seeds = list(range(args.first_seed, args.first_seed + args.resets))
     task = task_overrides(args.task)
-    header = ("| category | hinge on part edge | dense geometry | slide along front | direction (deg) | "
-              "sign right | line (cm, mean) | line (cm, median) | grasp point (cm) | grasp > 10 cm | "
-              "resets |")
-    table, results = [header, "|" + " --- |" * 11], []
+    header = ("| category | hinge on part edge | dense geometry | slide along front | coplanar panel | "
+              "direction (deg) | sign right | line (cm, mean) | line (cm, median) | grasp point (cm) | "
+              "grasp > 10 cm | resets |")
+    table, results = [header, "|" + " --- |" * 12], []
     for category in args.categories:
-        for flag, dense, front in flags:
-            wrapper = {"source": "capt", "every_k_steps": 1, "hinge_on_part_edge": flag,
-                       "dense_geometry": dense, "slide_along_front": front,
+        for combo in combos:
+            wrapper = {"source": "capt", "every_k_steps": 1,
+                       "hinge_on_part_edge": combo["hinge_on_part_edge"],
+                       "dense_geometry": combo["dense_geometry"],
+                       "slide_along_front": combo["slide_along_front"],
+                       "panel_max_state": panel_on if combo["coplanar_panel"] else 0.0,
                        "checkpoint": str(args.checkpoint or default_checkpoint(category))}
             env = make_env(category, wrapper, task=task, obs_mode="pointcloud")
             rows = []
             try:
-                desc = f"{category} hinge-on-edge {_on(flag)} dense {_on(dense)} front {_on(front)}"
+                desc = category + "".join(f" {k.split('_')[0]} {_on(v)}" for k, v in combo.items())
                 for seed in tqdm(seeds, desc=desc, leave=False):
                     _, info = env.reset(seed=seed)
                     rows.append({"seed": seed, **estimate_errors(env.estimate, ground_truth_estimate(info))})
             finally:
                 env.close()
             s = _summary(rows)
-            results.append({"category": category, "hinge_on_part_edge": flag, "dense_geometry": dense,
-                            "slide_along_front": front,
-                            **s, "per_reset": rows})
-            table.append(f"| {category.replace('_', ' ')} | {_on(flag)} | {_on(dense)} | {_on(front)} | "
+            results.append({"category": category, **combo, **s, "per_reset": rows})
+            on_off = "".join(f"{_on(v)} | " for v in combo.values())
+            table.append(f"| {category.replace('_', ' ')} | {on_off}"
                          f"{s['direction_deg_mean']:.1f} | {s['sign_right']:.2f} | {_cm(s['line_m_mean'])} | "
                          f"{_cm(s['line_m_median'])} | {100 * s['grasp_m_mean']:.1f} | "
                          f"{s['grasp_far']:.2f} | {s['resets']} |")
