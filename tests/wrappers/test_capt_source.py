@@ -112,3 +112,44 @@ def test_a_low_handle_with_few_points_still_counts_in_a_stack() -> None:
     source._estimator = _StackNetwork(labels[keep])
     est = source.estimate(dense[keep], {"target_joint": np.array([0])}, dense_points=dense)
     np.testing.assert_allclose(est.grasp_point, [-0.03, 0.0, 0.09], atol=0.015)
+
+
+def _half_labelled_door(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A closed cabinet door in the plane x = -0.2 facing -x (y in [-0.2, 0.2], z in [0, 0.4]),
+    hinged at y = -0.2, a bar handle 3 cm out at y = 0.16 (z 0.15..0.25), and the carcass's top
+    behind it. Labelled as CAPT did on cabinet door seed 150: only the door's handle half (y > 0.05)
+    and the handle are the moving part (1). World frame, metres."""
+    door = np.column_stack([np.full(800, -0.2), rng.uniform(-0.2, 0.2, 800), rng.uniform(0.0, 0.4, 800)])
+    handle = np.column_stack([np.full(40, -0.23), np.full(40, 0.16), rng.uniform(0.15, 0.25, 40)])
+    top = np.column_stack([rng.uniform(-0.2, 0.2, 400), rng.uniform(-0.2, 0.2, 400), np.full(400, 0.42)])
+    points = np.concatenate([door, handle, top]) + rng.normal(0.0, 0.001, (1240, 3))
+    labels = np.concatenate([(door[:, 1] > 0.05).astype(int), np.ones(40, int), np.zeros(400, int)])
+    return points, labels
+
+
+class _DoorNetwork:
+    """A revolute joint about +z with CAPT's line mid-door (y = 0.1, 30 cm off the hinge) and the
+    given state (rad)."""
+
+    def __init__(self, labels: np.ndarray, state: float) -> None:
+        self.labels, self.state = labels, state
+        self.config = SimpleNamespace(model=SimpleNamespace(joint_child_parts=(1,), joint_types=("revolute",)))
+
+    def predict(self, points: np.ndarray) -> ArticulationEstimate:
+        joint = JointEstimate(0, "revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.2, 0.1, 0.2]),
+                              self.state, 0.9)
+        return ArticulationEstimate(self.labels, (joint,), 1.0)
+
+
+@pytest.mark.parametrize("panel_max_state, state, hinge_y", [(0.35, 0.1, -0.2), (0.0, 0.1, 0.1),
+                                                             (0.35, 0.5, 0.1)])
+def test_a_closed_door_labelled_by_half_is_hinged_on_its_whole_panel(panel_max_state: float, state: float,
+                                                                      hinge_y: float) -> None:
+    points, labels = _half_labelled_door(np.random.default_rng(0))
+    source = CaptSource("unused.pt", hinge_on_part_edge=True, panel_max_state=panel_max_state)
+    source._estimator = _DoorNetwork(labels, state)
+    est = source.estimate(points, {"target_joint": np.array([0])})
+    np.testing.assert_allclose(est.grasp_point[:2], [-0.23, 0.16], atol=0.01)  # the handle
+    # on the panel the line is the door's far edge; without it (or once CAPT says the door is open)
+    # CAPT's own line stays, within 6 cm of the labelled half's edge at y = 0.05
+    np.testing.assert_allclose(est.pivot[1], hinge_y, atol=0.02)
