@@ -133,7 +133,8 @@ class _DoorNetwork:
 
     def __init__(self, labels: np.ndarray, state: float) -> None:
         self.labels, self.state = labels, state
-        self.config = SimpleNamespace(model=SimpleNamespace(joint_child_parts=(1,), joint_types=("revolute",)))
+        model = SimpleNamespace(joint_child_parts=(1,), joint_types=("revolute",))
+        self.config = SimpleNamespace(model=model)
 
     def predict(self, points: np.ndarray) -> ArticulationEstimate:
         joint = JointEstimate(0, "revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.2, 0.1, 0.2]),
