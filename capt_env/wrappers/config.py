@@ -93,9 +93,9 @@ class PerceptionWrapperConfig:
     of points) when that front faces within 0.6 rad of CAPT's direction; off, the direction is
     CAPT's own, only its sign set by the front. ``panel_max_state`` (``capt`` only, rad, 0 off):
     while CAPT's state of a revolute joint is under it (the part is about closed), the hinge edge
-    and the handle are looked for on the whole flat panel the moving part lies on (its in-plane points joined to it:
-    ``moving_part_geometry.coplanar_panel``), not only on the points CAPT labels as moving (it can
-    label the handle's half of a door only).
+    and the handle are looked for on the whole flat panel the moving part lies on (its in-plane
+    points joined to it: ``moving_part_geometry.coplanar_panel``), not only on the points CAPT
+    labels as moving (it can label the handle's half of a door only).
     """
 
     source: Source = "oracle"
