@@ -77,7 +77,11 @@ class ScriptedOpenerConfig:
     the door's sweep) and waits while the perceived state still rises by ``settle_progress`` rad over
     ``settle_window`` steps (a door falling open; one that creeps is grasped again; at most
     ``settle_max_steps``); then it is done if the door fell past ``fall_open_done`` and grasps again
-    otherwise (``fall_open_done`` 0: all of this off).
+    otherwise (``fall_open_done`` 0: all of this off). With ``watch_falling``, such a door seen falling
+    open before it is grasped (at least ``settle_above`` rad open and risen by ``settle_progress`` rad
+    over the last ``settle_window`` steps: the hand turning in front of it brushed it, or it was let go
+    short of open) is not reached for (reaching for the handle pushed it back, oven seeds 57 and 129):
+    the hand clears its sweep and waits the same way, then grasps it anew if it stopped short.
     A pull of any other revolute part (not a lid, nor a door that falls open) that stalls past
     ``revolute_stop_above`` rad (the hand's own measure), the fingers still holding and no wrist joint
     at its limit, has met the part's end stop and is not grasped again (0: off): a side-hinged door
@@ -157,6 +161,7 @@ class ScriptedOpenerConfig:
     settle_window: int = 10
     settle_progress: float = 0.06
     settle_max_steps: int = 40
+    watch_falling: bool = True
     release_steps: int = 6
     arc_fit: bool = True
     arc_fit_min_chord: float = 0.06

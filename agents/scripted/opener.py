@@ -266,6 +266,7 @@ class ScriptedOpener:
         self._falls = False  # the part being pulled falls open when let go (see falls_open)
         self._let_go_state = 0.0  # the part's state (rad or m) when a pull last let go of it
         self._settle: list[float] | None = None  # perceived states while waiting for a falling part
+        self._watch: list[float] = []  # perceived states of a part that falls open, before its grasp
         self._other_fingers = False  # the next grasp turns the fingers the other way round
         self.rehearsals: tuple[Rehearsal, Rehearsal] | None = None  # the last finger-order rehearsal
         self._still = 0
@@ -282,6 +283,8 @@ class ScriptedOpener:
                 float(np.linalg.norm(rotation_error(r_des, r))))
 
     def _set(self, phase: Phase) -> None:
+        if phase != Phase.APPROACH:
+            self._watch = []
         self.phase = phase
         self.phase_steps = 0
         self._still = 0
@@ -327,6 +330,15 @@ class ScriptedOpener:
         self.phase_steps += 1
 
         if self.phase in (Phase.PREGRASP, Phase.APPROACH):
+            if self._falling_on_its_own(est):
+                # the door is falling open ahead of the hand (brushed by it while turning, or let go
+                # short of open): reaching for its handle would push it back, so clear its sweep and
+                # wait (see RETREAT); if it stops short of fall_open_done it is grasped anew
+                self._grasp_p = np.array(est.grasp_point, dtype=np.float64)
+                self._grasp_again, self._target_r = True, None
+                self._retreat_from, self._settle = p.copy(), []
+                self._set(Phase.RETREAT)
+                return hold(GRIPPER_OPEN)
             if self.phase == Phase.PREGRASP:
                 self._pregrasp_steps += 1
                 if (self._pregrasp_steps <= cfg.rechoose_steps and self._grasp_point_moved(est)):
@@ -515,6 +527,19 @@ class ScriptedOpener:
         # kept for the rest of the pull: a hand that later slips off the handle leaves the arc
         self._hinge_fit = fit[0]
         return fit[0]
+
+    def _falling_on_its_own(self, est: JointAxisEstimate) -> bool:
+        """Whether, before its grasp, a part that :func:`falls_open` is seen falling open: at least
+        ``settle_above`` rad open and risen by ``settle_progress`` rad over the last ``settle_window``
+        steps (``watch_falling`` and ``fall_open_done`` > 0; never while lifting a lid)."""
+        cfg = self.cfg
+        if not cfg.watch_falling or cfg.fall_open_done <= 0.0 or self._lift or not falls_open(est, cfg):
+            self._watch = []
+            return False
+        self._watch.append(float(est.state))
+        states = self._watch
+        return (len(states) > cfg.settle_window and states[-1] >= cfg.settle_above
+                and states[-1] - states[-1 - cfg.settle_window] >= cfg.settle_progress)
 
     def _lets_fall(self) -> bool:
         """Whether to let the part being pulled fall open when the hand loses it: it

@@ -338,6 +338,54 @@ def test_a_door_that_stays_where_it_was_let_go_is_grasped_again() -> None:
                 break
         assert opener.phase == Phase.PREGRASP
 
+def _reaching_for(states: list[float], cfg: ScriptedOpenerConfig) -> tuple[ScriptedOpener, int]:
+    """An opener reaching for the falling oven's handle (hand held still 0.2 m in front of the
+    hinge) while the door is perceived at each of ``states`` (rad) in turn, until it stops reaching
+    (pre-grasp, then approach); returns it and the index of the last state it saw."""
+    opener = ScriptedOpener(cfg)
+    hand = _pose(grasp_rotation(_falling_oven(0.0), np.eye(3), cfg), np.array([-0.2, 0.0, 0.3]))
+    for k, state in enumerate(states):  # noqa: B007
+        opener.act_on(_falling_oven(state), hand)
+        if opener.phase not in (Phase.PREGRASP, Phase.APPROACH):
+            break
+    return opener, k
+
+
+def test_a_door_seen_falling_open_before_its_grasp_is_waited_for_not_reached_for() -> None:
+    cfg = ScriptedOpenerConfig()
+    falling = [0.51 + 0.02 * k for k in range(40)]  # brushed by the turning hand, falling open
+    opener, seen = _reaching_for(falling, cfg)
+    # waits (in RETREAT) from the first look at least settle_above open that has risen by
+    # settle_progress since settle_window looks before (0.81 rad, the 16th)
+    assert cfg.settle_above == pytest.approx(0.8) and cfg.settle_window == 10
+    assert seen == 15 and opener.phase == Phase.RETREAT and opener._settle == [] and opener._grasp_again
+    assert opener._target_r is None and opener.regrasps == 0
+    hand = _pose(np.eye(3), np.array([-0.2, 0.0, 0.3]))
+    rest = _falling_oven(cfg.fall_open_done + 0.1)  # it came to rest fallen open: done
+    actions = _hold_until_phase_changes(opener, rest, hand)
+    assert opener.phase == Phase.DONE and len(actions) == cfg.settle_window + 1
+    # one that stops short of fall_open_done is grasped anew, the grasp orientation chosen again
+    opener, _ = _reaching_for(falling, cfg)
+    _hold_until_phase_changes(opener, _falling_oven(1.0), hand)
+    assert opener.phase == Phase.PREGRASP and opener._target_r is None and opener._settle is None
+    # a door creeping open (pushed by the reaching hand), one still short of settle_above, the
+    # option off, or a side door swinging: reached for as before (the still hand, blocked, goes on
+    # to close its fingers)
+    creeping = [0.8 + 0.004 * k for k in range(40)]
+    short = [0.2 + 0.02 * k for k in range(25)]
+    for states, config in ((creeping, cfg), (short, cfg),
+                           (falling, ScriptedOpenerConfig(watch_falling=False)),
+                           (falling, ScriptedOpenerConfig(fall_open_done=0.0))):
+        opener, seen = _reaching_for(states, config)
+        assert seen > cfg.settle_window and opener.phase != Phase.RETREAT and opener._settle is None
+    side = ScriptedOpener(cfg)
+    for k in range(40):
+        est = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]),
+                                0.5 + 0.02 * k, np.array([-0.1, 0.2, 0.3]))
+        side.act_on(est, _pose(np.eye(3), np.array([-0.3, 0.0, 0.3])))
+    assert side.phase != Phase.RETREAT and side._settle is None
+
+
 def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: float) -> ScriptedOpener:
     """An opener that grasped a closed door on a vertical hinge (+z at y = -0.2 m, handle 0.4 m
     from it, opening towards -x) and whose hand, fingers ``finger_gap`` m apart, stopped with the
