@@ -25,7 +25,11 @@ class ScriptedOpenerConfig:
     than ``rechoose_grasp_m`` m from the one it was chosen for (0: never): a first look that finds no
     handle puts the grasp point on the part's far edge, and an orientation chosen for that point does
     not suit the handle seen a few steps later (not later on: an open part's grasp point jumps about
-    from look to look, and each start over turns the hand first). The fingers
+    from look to look, and each start over turns the hand first). With ``rechoose_looks`` n > 1,
+    only when each of the last n looks (new estimates) is that far from it and they agree with each
+    other within ``rechoose_grasp_m`` (CAPT's grasp point on a washing machine's door can jump between
+    looks: on seeds 2 and 4 the orientation was chosen again on three looks running and the fingers
+    then closed on nothing). The fingers
     approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched fingertip
     off the surface a handle stands on, but under 6 cm a finger pitched across a drawer's bar clips its
     edge when the grasp point is half a centimetre off). Moves are capped at ``max_step_m`` /
@@ -115,6 +119,7 @@ class ScriptedOpenerConfig:
     rotate_first_steps: int = 25
     rechoose_grasp_m: float = 0.05
     rechoose_steps: int = 30
+    rechoose_looks: int = 1
     max_step_m: float = 0.03
     max_step_rad: float = 0.15
     pos_tolerance: float = 0.012
@@ -187,6 +192,7 @@ class ScriptedOpenerConfig:
         require(self.rechoose_grasp_m >= 0,
                 f"rechoose_grasp_m must be >= 0 m (0: never), got {self.rechoose_grasp_m}")
         require(self.rechoose_steps >= 0, f"rechoose_steps must be >= 0, got {self.rechoose_steps}")
+        require(self.rechoose_looks >= 1, f"rechoose_looks must be >= 1, got {self.rechoose_looks}")
         require(self.rotate_first_steps >= 0,
                 f"rotate_first_steps must be >= 0 (0: never), got {self.rotate_first_steps}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",

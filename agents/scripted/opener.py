@@ -252,6 +252,7 @@ class ScriptedOpener:
         self._grasp_u: np.ndarray | None = None
         self._target_r: np.ndarray | None = None
         self._target_for: np.ndarray | None = None  # the grasp point _target_r was chosen for
+        self._looks: list[np.ndarray] = []  # the grasp points seen since, one per new estimate
         self._swap_this_grasp = False  # this grasp turns the fingers the other way round
         self._pregrasp_steps = 0  # steps this grasp has spent in PREGRASP, moves started over included
         self._lid = False
@@ -293,9 +294,18 @@ class ScriptedOpener:
     def _grasp_point_moved(self, est: JointAxisEstimate) -> bool:
         """Whether ``est``'s grasp point is more than ``rechoose_grasp_m`` m from the one the grasp
         orientation was chosen for (False before one is chosen or with ``rechoose_grasp_m`` 0)."""
-        if self.cfg.rechoose_grasp_m <= 0 or self._target_r is None or self._target_for is None:
+        cfg = self.cfg
+        if cfg.rechoose_grasp_m <= 0 or self._target_r is None or self._target_for is None:
             return False
-        return float(np.linalg.norm(est.grasp_point - self._target_for)) > self.cfg.rechoose_grasp_m
+        point = np.asarray(est.grasp_point, dtype=np.float64)
+        if not self._looks or float(np.linalg.norm(point - self._looks[-1])) > 1e-9:
+            self._looks.append(point.copy())  # a new look
+        recent = self._looks[-cfg.rechoose_looks:]
+        if len(recent) < cfg.rechoose_looks:
+            return False
+        target_for = self._target_for
+        return all(float(np.linalg.norm(q - target_for)) > cfg.rechoose_grasp_m for q in recent) and all(
+            float(np.linalg.norm(q - recent[-1])) <= cfg.rechoose_grasp_m for q in recent)
 
     def _reached(self, p: np.ndarray, perr: float, rerr: float) -> bool:
         """A move ends at the goal, on timeout, or when blocked (TCP still for ``blocked_steps``)."""
@@ -356,6 +366,7 @@ class ScriptedOpener:
                 if self._swap_this_grasp:
                     self._target_r = self._target_r @ _SWAP_FINGERS
                 self._target_for = np.array(est.grasp_point, dtype=np.float64)
+                self._looks = [self._target_for.copy()]
                 self._lid = is_lid(est, cfg)
             lift = lift_pose(est, r, cfg, self.phase) if self._lift else None
             if lift is not None:

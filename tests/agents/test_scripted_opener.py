@@ -546,6 +546,34 @@ def test_the_grasp_orientation_is_chosen_again_for_a_grasp_point_seen_elsewhere(
     assert opener.phase_steps == 2
 
 
+def test_with_rechoose_looks_the_grasp_orientation_follows_only_a_grasp_point_seen_twice() -> None:
+    # CAPT's grasp point on a washing machine's door jumps between looks (handle found or not): with
+    # rechoose_looks 2 the orientation is chosen again only for two successive looks that agree
+    first = JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.zeros(3), 0.0,
+                              np.array([0.1, -0.15, 0.2]))
+    handle = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([0.1, -0.2, 0.2]), 0.0,
+                               np.array([0.1, 0.15, 0.2]))
+    near_handle = JointAxisEstimate("revolute", handle.direction, handle.pivot, 0.0,
+                                    handle.grasp_point + [0.0, 0.02, 0.0])
+    away = np.array([-0.2, 0.0, 0.4, 0.0, 1.0, 0.0, 0.0])  # TCP above the part, pointing down (wxyz)
+    r = Rotation.from_quat(away[3:], scalar_first=True).as_matrix()
+    cfg = ScriptedOpenerConfig(rechoose_looks=2)
+    chose_first = grasp_rotation(first, r, cfg)
+    opener = ScriptedOpener(cfg)
+    for est in (first, handle, first, handle, first):  # looks that keep jumping: kept
+        for _ in range(2):
+            opener.act_on(est, away)
+        np.testing.assert_allclose(opener._target_r, chose_first, atol=1e-9)
+    assert opener.phase_steps == 10
+    opener.act_on(handle, away)  # one look at the handle: not yet
+    np.testing.assert_allclose(opener._target_r, chose_first, atol=1e-9)
+    opener.act_on(near_handle, away)  # the next look agrees (2 cm away): chosen again, move restarted
+    np.testing.assert_allclose(opener._target_r, grasp_rotation(near_handle, r, cfg), atol=1e-9)
+    assert opener.phase_steps == 1
+    with pytest.raises(ConfigError, match="rechoose_looks"):
+        from_dict(ScriptedOpenerConfig, {"rechoose_looks": 0})
+
+
 def test_the_finger_order_the_wrist_cannot_reach_is_rehearsed_and_not_taken() -> None:
     # the hand points down with joint 7 turned 1.8 rad from where the TCP's x is world +x: of the two
     # finger orders for a straight-down grasp (x = +x or -x), the nearer one (1.34 rad) needs joint 7
