@@ -293,7 +293,9 @@ class ScriptedOpener:
 
     def _grasp_point_moved(self, est: JointAxisEstimate) -> bool:
         """Whether ``est``'s grasp point is more than ``rechoose_grasp_m`` m from the one the grasp
-        orientation was chosen for (False before one is chosen or with ``rechoose_grasp_m`` 0)."""
+        orientation was chosen for, on each of the last ``rechoose_looks`` looks (distinct
+        estimates), which agree with each other within ``rechoose_grasp_m`` (False before one is
+        chosen or with ``rechoose_grasp_m`` 0)."""
         cfg = self.cfg
         if cfg.rechoose_grasp_m <= 0 or self._target_r is None or self._target_for is None:
             return False
