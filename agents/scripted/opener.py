@@ -550,9 +550,13 @@ class ScriptedOpener:
             self._watch = []
             return False
         self._watch.append(float(est.state))
-        states = self._watch
-        return (len(states) > cfg.settle_window and states[-1] >= cfg.settle_above
-                and states[-1] - states[-1 - cfg.settle_window] >= cfg.settle_progress)
+        return self._watch[-1] >= cfg.settle_above and self._risen(self._watch)
+
+    def _risen(self, states: list[float]) -> bool:
+        """Whether the last of ``states`` (rad, one per step) is ``settle_progress`` above the one
+        ``settle_window`` steps before (False with fewer states than that)."""
+        window = self.cfg.settle_window
+        return len(states) > window and states[-1] - states[-1 - window] >= self.cfg.settle_progress
 
     def _lets_fall(self) -> bool:
         """Whether to let the part being pulled fall open when the hand loses it: it
@@ -578,8 +582,7 @@ class ScriptedOpener:
         action, _, _ = self._goto(p, r, goal, r, GRIPPER_OPEN)
         self._settle.append(float(est.state))
         states = self._settle
-        rising = len(states) <= cfg.settle_window or (
-            states[-1] - states[-1 - cfg.settle_window] >= cfg.settle_progress)
+        rising = len(states) <= cfg.settle_window or self._risen(states)
         if rising and len(states) < cfg.settle_max_steps:
             return action
         self._settle = None
