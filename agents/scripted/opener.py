@@ -24,8 +24,9 @@ Strategy, per episode:
    (``rehearse_fingers``; :mod:`agents.scripted.grasp_rehearsal`).
 2. ``APPROACH``: advance to ``grasp_depth`` past the grasp point. 3. ``CLOSE`` the gripper. If a
    lid's fingers closed on nothing (its lip is wider than the open fingers), the hand backs off and
-   lifts the lid from below instead (:func:`lift_pose`): fingers closed, pointing at the hinge and
-   steeply down, the fingertips slide in under the grasp point, then push along the arc as in 4.
+   lifts the lid from below instead (:func:`~agents.scripted.grasp_pose.lift_pose`): fingers
+   closed, pointing at the hinge and steeply down, the fingertips slide in under the grasp point,
+   then push along the arc as in 4.
 4. ``PULL``: the part's state is measured by the hand itself while it holds the part (the grasp-time
    estimate plus the TCP's swept angle about the estimated axis, or its travel along it), every
    step and free of the perceived state's noise. About a hinge, once the holding hand's path is
@@ -43,9 +44,10 @@ have closed on nothing (their gap, from the Panda's qpos, below ``hold_gap``), i
 if pulling stalls short of the target (a slipping grip, or the arm's range), it releases, retreats
 and goes back to 1 from the part's new pose (re-grasps are bounded by ``max_regrasps``). A prismatic
 part that brakes the pulling hand (see ``limit_slowdown``) has reached its end stop: the hand
-releases, retreats and is done. A door that gravity opens (:func:`falls_open`, an oven door) is
-not grasped again once the hand loses it past ``fall_open_done``; short of that, the open hand moves
-out of the door's sweep and waits while it falls, then is done or grasps again (``RETREAT``).
+releases, retreats and is done. A door that gravity opens
+(:func:`~agents.scripted.grasp_pose.falls_open`, an oven door) is not grasped again once the hand
+loses it past ``fall_open_done``; short of that, the open hand moves out of the door's sweep and
+waits while it falls, then is done or grasps again (``RETREAT``).
 """
 
 from __future__ import annotations
@@ -60,12 +62,19 @@ from agents.scripted.geometry import (
     axis_angle_matrix,
     clip_norm,
     fit_circle,
-    grasp_frame,
     off_axis,
-    perpendicular,
     quat_to_matrix,
     rotation_error,
     swept_angle,
+)
+from agents.scripted.grasp_pose import (
+    SWAP_FINGERS,
+    falls_open,
+    grasp_rotation,
+    grasp_target,
+    is_lid,
+    is_vertical_hinge,
+    lift_pose,
 )
 from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
 from agents.scripted.panda_kinematics import PANDA_LOWER, PANDA_UPPER, pose_matrix
@@ -78,8 +87,6 @@ ACTION_SCALE_M = 0.1  # pd_ee_delta_pose: metres per unit translation action
 # ManiSkill 3.0.1's PDEEPoseController multiplies rotation actions by ``rot_lower`` (-0.1 for the Panda),
 # so a unit rotation action turns by -0.1 rad (XYZ Euler ~ rotation vector at these small angles).
 ACTION_SCALE_RAD = -0.1
-_UP = np.array([0.0, 0.0, 1.0])
-_SWAP_FINGERS = np.diag([-1.0, -1.0, 1.0])  # the same approach with the fingers the other way round
 # the Panda's wrist joints 5, 6 and 7 (rad), from its URDF
 _WRIST_LOWER, _WRIST_UPPER = PANDA_LOWER[4:], PANDA_UPPER[4:]
 # ManiSkill's Panda gripper maps action [-1, 1] linearly to each finger's position [-0.01, 0.04] m.
@@ -110,107 +117,6 @@ def hold(gripper: float) -> np.ndarray:
     action[6] = gripper
     return action
 
-def outward_normal(est: JointAxisEstimate) -> np.ndarray:
-    """World-frame unit direction in which the grasp point moves when the part opens."""
-    u = unit(est.direction)
-    if est.joint_type == "prismatic":
-        return u
-    return unit(np.cross(u, est.grasp_point - est.pivot))
-
-
-def is_vertical_hinge(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
-    """Whether ``est`` is a revolute joint whose axis is within ``vertical_hinge_max_tilt`` of vertical."""
-    if est.joint_type != "revolute":
-        return False
-    return abs(float(unit(est.direction)[2])) >= float(np.cos(cfg.vertical_hinge_max_tilt))
-
-
-def is_lid(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
-    """Whether ``est`` is a revolute part that opens upwards at its grasp point, within
-    ``lid_max_tilt`` rad of straight up (a closed lid: the hand comes down from above)."""
-    if est.joint_type != "revolute":
-        return False
-    return float(outward_normal(est)[2]) >= float(np.cos(cfg.lid_max_tilt))
-
-
-def falls_open(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
-    """Whether ``est`` is a part that gravity opens further once it is let go: a revolute part about
-    a non-vertical hinge whose grasp point, closed (turned back by the estimated state), is above
-    the hinge line, and which is not a lid (an oven door, hinged at its foot)."""
-    if est.joint_type != "revolute" or is_vertical_hinge(est, cfg) or is_lid(est, cfg):
-        return False
-    u = unit(est.direction)
-    closed = axis_angle_matrix(u, -float(est.state)) @ (est.grasp_point - est.pivot)
-    return float(off_axis(closed, u)[2]) > 0.0
-
-
-def lid_frame(est: JointAxisEstimate) -> tuple[np.ndarray, np.ndarray] | None:
-    """World unit directions (front, up) at a lid's grasp point: ``front`` along the radius from the
-    hinge out through the grasp point, ``up`` the direction the grasp point opens in
-    (:func:`outward_normal`). None when the grasp point lies on the hinge line."""
-    front = perpendicular(unit(est.direction), est.grasp_point - est.pivot)
-    return None if front is None else (front, outward_normal(est))
-
-
-def grasp_target(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> np.ndarray:
-    """World point (3,) the TCP grips: the grasp point, moved ``lid_edge_offset`` m further from the
-    hinge on a lid (the fingers then pinch the front of the lip and clear the lid's edge)."""
-    frame = lid_frame(est) if is_lid(est, cfg) else None
-    return est.grasp_point if frame is None else est.grasp_point + cfg.lid_edge_offset * frame[0]
-
-
-def lift_pose(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig,
-              phase: Phase) -> tuple[np.ndarray, np.ndarray] | None:
-    """TCP goal (position (3,) m, rotation (3, 3)), world frame, for lifting a lid from below: the
-    closed fingertips, pointing at the hinge and ``lid_lift_pitch`` rad down, go
-    ``lid_lift_below`` m under the grasp point, from ``lid_lift_front`` m in front of it (``PREGRASP``)
-    to ``lid_lift_under`` m behind it (``APPROACH``). For a lip wider than the open fingers."""
-    frame = lid_frame(est)
-    if frame is None:
-        return None
-    front, up = frame
-    approach = -np.cos(cfg.lid_lift_pitch) * front - np.sin(cfg.lid_lift_pitch) * up
-    # front, up and the hinge are orthonormal; the fingers close along the hinge
-    rot = nearer_finger_order(grasp_frame(approach, unit(est.direction)), current)
-    ahead = cfg.lid_lift_front if phase == Phase.PREGRASP else -cfg.lid_lift_under
-    return est.grasp_point + ahead * front - cfg.lid_lift_below * up, rot
-
-
-def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig) -> np.ndarray:
-    """TCP rotation (3, 3) for grasping: approach along -n, fingers closing across the handle.
-
-    Of the two finger orientations (closing c or -c) the one nearer ``current`` is chosen.
-    """
-    n = outward_normal(est)
-    approach = -n
-    if is_lid(est, cfg):
-        # a part lying flat and opening upwards (a lid): along the radius one finger would come down
-        # on the part itself, so the fingers close along the hinge, across the lid's front lip
-        closing = perpendicular(approach, unit(est.direction))
-    elif est.joint_type == "revolute":
-        closing = perpendicular(approach, est.grasp_point - est.pivot)
-    else:
-        closing = perpendicular(approach, _UP)
-    if closing is None:
-        closing = perpendicular(approach, np.array([0.0, 1.0, 0.0]))
-        assert closing is not None
-    frame = grasp_frame(approach, closing)
-    elevation = float(np.arcsin(np.clip(approach[2], -1.0, 1.0)))
-    horizontal = perpendicular(approach, _UP)
-    pitch = cfg.vertical_hinge_pitch if is_vertical_hinge(est, cfg) else cfg.approach_pitch
-    if elevation > -pitch and horizontal is not None:
-        # point the hand down by turning about the horizontal axis across the approach: the Panda's
-        # wrist cannot point level at table height, and a handle bar stays between the fingers
-        # (the bar is either along that axis or perpendicular to the closing direction)
-        side = np.cross(approach, _UP)
-        side = side / np.linalg.norm(side)
-        rot = axis_angle_matrix(side, -(elevation + pitch))
-        if (rot @ approach)[2] > approach[2]:
-            rot = rot.T
-        frame = rot @ frame
-    return nearer_finger_order(frame, current)
-
-
 def wrist_at_limit(arm_qpos: np.ndarray | None, margin: float) -> bool:
     """Whether one of the Panda's wrist joints (5, 6, 7) in ``arm_qpos`` (7,) rad is within ``margin``
     rad of its limit; False for no joint angles or a margin of 0 (off)."""
@@ -218,15 +124,6 @@ def wrist_at_limit(arm_qpos: np.ndarray | None, margin: float) -> bool:
         return False
     wrist = np.asarray(arm_qpos, dtype=np.float64).reshape(-1)[4:7]
     return bool(np.any(wrist < _WRIST_LOWER + margin) or np.any(wrist > _WRIST_UPPER - margin))
-
-
-def nearer_finger_order(frame: np.ndarray, current: np.ndarray) -> np.ndarray:
-    """Of TCP rotation ``frame`` (3, 3) and the same approach with the fingers swapped, the one
-    nearer the current rotation ``current`` (3, 3)."""
-    flipped = frame @ _SWAP_FINGERS
-    if np.linalg.norm(rotation_error(flipped, current)) < np.linalg.norm(rotation_error(frame, current)):
-        return flipped
-    return frame
 
 
 class ScriptedOpener:
@@ -366,11 +263,11 @@ class ScriptedOpener:
                 if cfg.rehearse_fingers and arm_qpos is not None and not is_lid(est, cfg):
                     self._target_r = self._rehearsed_fingers(est, p, r, arm_qpos, self._target_r)
                 if self._swap_this_grasp:
-                    self._target_r = self._target_r @ _SWAP_FINGERS
+                    self._target_r = self._target_r @ SWAP_FINGERS
                 self._target_for = np.array(est.grasp_point, dtype=np.float64)
                 self._looks = [self._target_for.copy()]
                 self._lid = is_lid(est, cfg)
-            lift = lift_pose(est, r, cfg, self.phase) if self._lift else None
+            lift = lift_pose(est, r, cfg, under=self.phase != Phase.PREGRASP) if self._lift else None
             if lift is not None:
                 goal, self._target_r = lift
                 gripper = GRIPPER_CLOSE
@@ -480,7 +377,7 @@ class ScriptedOpener:
         """``nearer`` (3, 3), or the same approach with the fingers swapped if the rehearsal says the
         arm reaches and pulls clearly better that way (see ``rehearse_fingers`` in the config)."""
         cfg = self.cfg
-        other = nearer @ _SWAP_FINGERS
+        other = nearer @ SWAP_FINGERS
 
         def reaches(x: Rehearsal) -> bool:
             return x.grasp_error_m <= 2 * cfg.pos_tolerance and x.grasp_error_rad <= 2 * cfg.rot_tolerance

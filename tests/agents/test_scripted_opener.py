@@ -9,9 +9,7 @@ from scipy.spatial.transform import Rotation
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
 from agents.scripted.geometry import axis_angle_matrix, fit_circle, swept_angle
-from agents.scripted.opener import (
-    ACTION_SCALE_M,
-    Phase,
+from agents.scripted.grasp_pose import (
     falls_open,
     grasp_rotation,
     grasp_target,
@@ -19,6 +17,7 @@ from agents.scripted.opener import (
     lift_pose,
     outward_normal,
 )
+from agents.scripted.opener import ACTION_SCALE_M, Phase
 from agents.scripted.panda_kinematics import tcp_pose
 from agents.scripted.rollout import make_env, run_episode
 from capt_env.wrappers.estimate import JointAxisEstimate
@@ -63,8 +62,8 @@ def test_a_lip_the_fingers_closed_on_nothing_is_lifted_from_below() -> None:
     assert opener.phase == Phase.RELEASE and opener._lift  # backs off, then lifts from below
     # the lift goals: closed fingertips lid_lift_below under the lip, coming from the front (-x)
     # towards the hinge (+x), pointing lid_lift_pitch below horizontal, closing along the hinge
-    pre, rot = lift_pose(est, np.eye(3), cfg, Phase.PREGRASP)
-    at, _ = lift_pose(est, np.eye(3), cfg, Phase.APPROACH)
+    pre, rot = lift_pose(est, np.eye(3), cfg, under=False)
+    at, _ = lift_pose(est, np.eye(3), cfg, under=True)
     np.testing.assert_allclose(pre, est.grasp_point + [-cfg.lid_lift_front, 0.0, -cfg.lid_lift_below],
                                atol=1e-9)
     np.testing.assert_allclose(at, est.grasp_point + [cfg.lid_lift_under, 0.0, -cfg.lid_lift_below],
