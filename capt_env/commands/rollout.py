@@ -6,12 +6,14 @@ import argparse
 from dataclasses import asdict
 from typing import TYPE_CHECKING
 
+from capt_env.commands.episode_log import EpisodeLog
 from capt_env.commands.json_output import write_json
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 from perception.yaml_config import to_dict
 
 if TYPE_CHECKING:
     from agents.scripted.config import ScriptedOpenerConfig
+    from agents.scripted.rollout import EpisodeResult
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -31,6 +33,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "configs/opener/steep_door_approach.yaml; default: the opener's defaults")
     add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
+    parser.add_argument("--episode-log", default=None,
+                        help="JSON-lines file: every episode is appended as it ends, and the episodes "
+                             "already there for the same evaluation are not played again (resume an "
+                             "interrupted run by repeating its command)")
 
 
 def opener_config(path: str | None) -> ScriptedOpenerConfig:
@@ -65,11 +71,35 @@ def _policy(args: argparse.Namespace, category: str,
     return ScriptedOpener(opener), None
 
 
-def run(args: argparse.Namespace) -> int:
-    import numpy as np
+def _episodes(env: object, policy: object, seeds: list[int], max_steps: int, desc: str,
+              log: EpisodeLog | None) -> list[EpisodeResult]:
+    """One episode per seed, in order; with ``log``, each appended as it ends and those it already
+    holds read back instead of played."""
     from tqdm import tqdm
 
-    from agents.scripted.rollout import make_env, run_episode
+    from agents.scripted.rollout import EpisodeResult, run_episode
+
+    done = {s: log.recorded(s) for s in seeds} if log is not None else {}
+    resumed = sum(e is not None for e in done.values())
+    if resumed:
+        print(f"{desc}: {resumed} of {len(seeds)} episodes read back from {log.path}")
+    episodes = []
+    for seed in tqdm(seeds, desc=desc):
+        recorded = done.get(seed)
+        if recorded is not None:
+            episodes.append(EpisodeResult(**recorded))
+            continue
+        episode = run_episode(env, policy, seed, max_steps)
+        if log is not None:
+            log.append(asdict(episode))
+        episodes.append(episode)
+    return episodes
+
+
+def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from agents.scripted.rollout import make_env
     from agents.success_stats import wilson_interval
 
     header = "| category | perception | success | 95% interval | mean opened | mean steps | episodes |"
@@ -89,11 +119,17 @@ def run(args: argparse.Namespace) -> int:
 
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
                 obs_mode = "pointcloud"
-            env = make_env(category, wrapper, task=task, obs_mode=obs_mode)
             policy, model = _policy(args, category, opener)
+            log = None
+            if args.episode_log is not None:
+                log = EpisodeLog(args.episode_log, {
+                    "category": category, "policy": args.policy, "model": model, "perception": source,
+                    "checkpoint": wrapper.get("checkpoint"), "every_k_steps": args.every_k_steps,
+                    "max_steps": args.max_steps, "task": task,
+                    "opener": None if opener is None else to_dict(opener)})
+            env = make_env(category, wrapper, task=task, obs_mode=obs_mode)
             try:
-                episodes = [run_episode(env, policy, s, args.max_steps)
-                            for s in tqdm(seeds, desc=f"{category} {source}")]
+                episodes = _episodes(env, policy, seeds, args.max_steps, f"{category} {source}", log)
             finally:
                 env.close()
             wins = sum(e.success for e in episodes)
