@@ -13,7 +13,6 @@ from perception.yaml_config import to_dict
 
 if TYPE_CHECKING:
     from agents.scripted.config import ScriptedOpenerConfig
-    from agents.scripted.rollout import EpisodeResult
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -33,6 +32,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "configs/opener/steep_door_approach.yaml; default: the opener's defaults")
     add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
+    parser.add_argument("--workers", type=int, default=1,
+                        help="processes that play episodes side by side (each with its own env and "
+                             "policy, torch on one thread); the episodes do not depend on it")
     parser.add_argument("--episode-log", default=None,
                         help="JSON-lines file: every episode is appended as it ends, and the episodes "
                              "already there for the same evaluation are not played again (resume an "
@@ -53,54 +55,24 @@ def opener_config(path: str | None) -> ScriptedOpenerConfig:
         raise SystemExit(f"--opener {path}: {err}") from err
 
 
-def _policy(args: argparse.Namespace, category: str,
-            opener: ScriptedOpenerConfig | None) -> tuple[object, str | None]:
-    """The policy to evaluate and its model file: the scripted opener with config ``opener`` (None),
-    or a trained PPO model (``--model``, else the category's shipped one)."""
-    if args.policy == "ppo":
-        from agents.ppo.policies import shipped_policy
-        from agents.ppo.policy import PPOPolicy
+def _model(args: argparse.Namespace, category: str) -> str | None:
+    """The PPO model file to evaluate (``--model``, else the category's shipped policy); None for the
+    scripted opener."""
+    if args.policy != "ppo":
+        return None
+    from agents.ppo.policies import shipped_policy
 
-        try:
-            model = args.model or shipped_policy(category)
-        except FileNotFoundError as err:
-            raise SystemExit(str(err)) from err
-        return PPOPolicy.load(model), str(model)
-    from agents.scripted.opener import ScriptedOpener
-
-    return ScriptedOpener(opener), None
-
-
-def _episodes(env: object, policy: object, seeds: list[int], max_steps: int, desc: str,
-              log: EpisodeLog | None) -> list[EpisodeResult]:
-    """One episode per seed, in order; with ``log``, each appended as it ends and those it already
-    holds read back instead of played."""
-    from tqdm import tqdm
-
-    from agents.scripted.rollout import EpisodeResult, run_episode
-
-    done = {s: log.recorded(s) for s in seeds} if log is not None else {}
-    resumed = sum(e is not None for e in done.values())
-    if resumed:
-        print(f"{desc}: {resumed} of {len(seeds)} episodes read back from {log.path}")
-    episodes = []
-    for seed in tqdm(seeds, desc=desc):
-        recorded = done.get(seed)
-        if recorded is not None:
-            episodes.append(EpisodeResult(**recorded))
-            continue
-        episode = run_episode(env, policy, seed, max_steps)
-        if log is not None:
-            log.append(asdict(episode))
-        episodes.append(episode)
-    return episodes
+    try:
+        return str(args.model or shipped_policy(category))
+    except FileNotFoundError as err:
+        raise SystemExit(str(err)) from err
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from agents.scripted.rollout import make_env
     from agents.success_stats import wilson_interval
+    from capt_env.commands.episode_runner import EpisodeJob, play_episodes
 
     header = "| category | perception | success | 95% interval | mean opened | mean steps | episodes |"
     rows, lines = [], [header, "| --- | --- | --- | --- | --- | --- | --- |"]
@@ -110,6 +82,10 @@ def run(args: argparse.Namespace) -> int:
         raise SystemExit("--opener configures the scripted policy; a PPO policy runs the opener "
                          "recorded with it")
     opener = opener_config(args.opener) if args.policy == "scripted" else None
+    if args.workers < 1:
+        raise SystemExit(f"--workers must be at least 1, got {args.workers}")
+    if args.episodes < 1:
+        raise SystemExit(f"--episodes must be at least 1, got {args.episodes}")
     for category in args.categories:
         for source in args.perception:
             wrapper = {"source": source, "every_k_steps": args.every_k_steps}
@@ -119,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
 
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
                 obs_mode = "pointcloud"
-            policy, model = _policy(args, category, opener)
+            model = _model(args, category)
             log = None
             if args.episode_log is not None:
                 log = EpisodeLog(args.episode_log, {
@@ -127,11 +103,8 @@ def run(args: argparse.Namespace) -> int:
                     "checkpoint": wrapper.get("checkpoint"), "every_k_steps": args.every_k_steps,
                     "max_steps": args.max_steps, "task": task,
                     "opener": None if opener is None else to_dict(opener)})
-            env = make_env(category, wrapper, task=task, obs_mode=obs_mode)
-            try:
-                episodes = _episodes(env, policy, seeds, args.max_steps, f"{category} {source}", log)
-            finally:
-                env.close()
+            job = EpisodeJob(category, wrapper, task, obs_mode, args.policy, model, opener, args.max_steps)
+            episodes = play_episodes(job, seeds, args.workers, log, desc=f"{category} {source}")
             wins = sum(e.success for e in episodes)
             lo, hi = wilson_interval(wins, len(episodes))
             row = {"category": category, "policy": args.policy, "model": model, "perception": source,
@@ -150,6 +123,7 @@ def run(args: argparse.Namespace) -> int:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
         Path(args.markdown).write_text(table + "\n")
     write_json(args.json, {"seeds": seeds, "policy": args.policy, "max_steps": args.max_steps,
+                           "workers": args.workers,
                            "every_k_steps": args.every_k_steps, "task": task,
                            "opener": None if opener is None else to_dict(opener),
                            "results": rows})

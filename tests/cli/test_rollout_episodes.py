@@ -1,4 +1,5 @@
-"""``capt rollout --episode-log``: finished episodes survive an interruption and are not played again."""
+"""``capt rollout``: finished episodes survive an interruption (``--episode-log``) and are not played
+again; worker processes (``--workers``) play the same episodes."""
 
 from __future__ import annotations
 
@@ -65,3 +66,21 @@ def test_rollout_resumes_from_its_episode_log(tmp_path: Path) -> None:
     assert episodes[:2] == first and episodes[2]["seed"] == 2
     assert main([*args, "--episodes", "1", "--max-steps", "4"]) == 0  # another run: played anew
     assert json.loads(log.read_text().splitlines()[-1])["episode"]["steps"] == 4
+
+
+def test_worker_processes_play_the_same_episodes(tmp_path: Path) -> None:
+    out = {n: tmp_path / f"rollout_{n}.json" for n in (1, 2)}
+    for workers, path in out.items():
+        assert main(["rollout", "--categories", "laptop", "--episodes", "3", "--max-steps", "25",
+                     "--workers", str(workers), "--json", str(path)]) == 0
+    one, two = (json.loads(out[n].read_text()) for n in (1, 2))
+    assert two["workers"] == 2 and [e["seed"] for e in two["results"][0]["episodes"]] == [0, 1, 2]
+    assert one["results"][0]["episodes"] == two["results"][0]["episodes"]
+    assert len({e["open_fraction"] for e in one["results"][0]["episodes"]}) > 1  # the seeds differ
+
+
+def test_bad_worker_and_episode_counts_are_named() -> None:
+    with pytest.raises(SystemExit, match="--workers"):
+        main(["rollout", "--workers", "0"])
+    with pytest.raises(SystemExit, match="--episodes"):
+        main(["rollout", "--episodes", "0"])
