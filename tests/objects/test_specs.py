@@ -19,6 +19,15 @@ def test_same_id_gives_equal_spec(category: str) -> None:
     assert a.params == b.params
 
 
+def test_the_package_exports_the_entry_points_the_readme_names() -> None:
+    import capt_env.objects as objects
+    from capt_env.objects.splits import instance_ids
+
+    assert objects.make_object("oven", 17) == make_object("oven", 17)
+    assert objects.instance_ids("oven", "test") == instance_ids("oven", "test")
+    assert objects.CATEGORIES == CATEGORIES
+
+
 @pytest.mark.parametrize("category", CATEGORIES)
 def test_hundred_ids_give_hundred_distinct_parameter_sets(category: str) -> None:
     keys = set()
