@@ -106,7 +106,12 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
     frame = grasp_frame(approach, closing)
     elevation = float(np.arcsin(np.clip(approach[2], -1.0, 1.0)))
     horizontal = perpendicular(approach, UP)
-    pitch = cfg.vertical_hinge_pitch if is_vertical_hinge(est, cfg) else cfg.approach_pitch
+    if is_vertical_hinge(est, cfg):
+        pitch = cfg.vertical_hinge_pitch
+    elif est.joint_type == "prismatic":
+        pitch = cfg.prismatic_approach_pitch
+    else:
+        pitch = cfg.approach_pitch
     if elevation > -pitch and horizontal is not None:
         # point the hand down by turning about the horizontal axis across the approach: the Panda's
         # wrist cannot point level at table height, and a handle bar stays between the fingers

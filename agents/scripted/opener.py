@@ -16,9 +16,10 @@ Strategy, per episode:
    ``axis x (grasp - pivot)``; prismatic: the axis), with the TCP approach axis along ``-n`` and the
    fingers closing perpendicular to the handle (revolute: along the radius from the axis, so a bar
    parallel to the hinge is enclosed; prismatic: vertically). The approach is pitched below
-   horizontal by at least ``vertical_hinge_pitch`` (doors) or ``approach_pitch`` (other parts), as
-   the Panda's wrist cannot point level near the table. A lid (its grasp point opens upwards) is
-   gripped from above, the fingers closing along the hinge across its front lip (``is_lid``).
+   horizontal by at least ``vertical_hinge_pitch`` (doors), ``prismatic_approach_pitch`` (drawers)
+   or ``approach_pitch`` (other parts), as the Panda's wrist cannot point level near the table. A
+   lid (its grasp point opens upwards) is gripped from above, the fingers closing along the hinge
+   across its front lip (``is_lid``).
    Of the two finger orders the one nearer the hand's rotation is taken, unless a rehearsal on the
    arm's kinematic model says only the other reaches the grasp and holds it through the pull
    (``rehearse_fingers``; :mod:`agents.scripted.grasp_rehearsal`).
