@@ -518,7 +518,7 @@ def test_the_grasp_orientation_is_chosen_again_for_a_grasp_point_seen_elsewhere(
     r = Rotation.from_quat(away[3:], scalar_first=True).as_matrix()
     for rechoose, expected in ((0.05, grasp_rotation(handle, r, ScriptedOpenerConfig())),
                                (0.0, grasp_rotation(first, r, ScriptedOpenerConfig()))):
-        opener = ScriptedOpener(ScriptedOpenerConfig(rechoose_grasp_m=rechoose))
+        opener = ScriptedOpener(ScriptedOpenerConfig(rechoose_grasp_m=rechoose, rechoose_looks=1))
         for _ in range(5):
             opener.act_on(first, away)
         assert opener.phase == Phase.PREGRASP and opener.phase_steps == 5
@@ -526,7 +526,7 @@ def test_the_grasp_orientation_is_chosen_again_for_a_grasp_point_seen_elsewhere(
         np.testing.assert_allclose(opener._target_r, expected, atol=1e-9)
         assert opener.phase_steps == (1 if rechoose > 0 else 6)  # the move starts over
     # late in the pre-grasp move (an open part's grasp point jumps about) it is not chosen again
-    opener = ScriptedOpener(ScriptedOpenerConfig(rechoose_steps=5))
+    opener = ScriptedOpener(ScriptedOpenerConfig(rechoose_steps=5, rechoose_looks=1))
     for _ in range(5):
         opener.act_on(first, away)
     opener.act_on(handle, away)
@@ -547,7 +547,8 @@ def test_the_grasp_orientation_is_chosen_again_for_a_grasp_point_seen_elsewhere(
 
 def test_with_rechoose_looks_the_grasp_orientation_follows_only_a_grasp_point_seen_twice() -> None:
     # CAPT's grasp point on a washing machine's door jumps between looks (handle found or not): with
-    # rechoose_looks 2 the orientation is chosen again only for two successive looks that agree
+    # rechoose_looks 2 (the default) the orientation is chosen again only for two successive looks
+    # that agree
     first = JointAxisEstimate("prismatic", np.array([-1.0, 0.0, 0.0]), np.zeros(3), 0.0,
                               np.array([0.1, -0.15, 0.2]))
     handle = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([0.1, -0.2, 0.2]), 0.0,
@@ -556,7 +557,8 @@ def test_with_rechoose_looks_the_grasp_orientation_follows_only_a_grasp_point_se
                                     handle.grasp_point + [0.0, 0.02, 0.0])
     away = np.array([-0.2, 0.0, 0.4, 0.0, 1.0, 0.0, 0.0])  # TCP above the part, pointing down (wxyz)
     r = Rotation.from_quat(away[3:], scalar_first=True).as_matrix()
-    cfg = ScriptedOpenerConfig(rechoose_looks=2)
+    cfg = ScriptedOpenerConfig()
+    assert cfg.rechoose_looks == 2
     chose_first = grasp_rotation(first, r, cfg)
     opener = ScriptedOpener(cfg)
     for est in (first, handle, first, handle, first):  # looks that keep jumping: kept

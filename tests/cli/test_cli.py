@@ -63,7 +63,7 @@ def test_rollout_opener_overrides_load_and_name_a_bad_key(tmp_path: Path) -> Non
     for path in sorted((repo / "configs" / "opener").glob("*.yaml")):
         assert opener_config(str(path)) != opener_config(None)  # each changes something
     assert opener_config(str(repo / "configs/opener/steep_door_approach.yaml")).vertical_hinge_pitch == 1.0
-    assert opener_config(str(repo / "configs/opener/rechoose_two_looks.yaml")).rechoose_looks == 2
+    assert opener_config(str(repo / "configs/opener/rechoose_every_look.yaml")).rechoose_looks == 1
     bad = tmp_path / "bad.yaml"
     bad.write_text("vertical_hinge_pich: 1.0\n")
     with pytest.raises(SystemExit, match="vertical_hinge_pich"):
