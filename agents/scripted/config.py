@@ -33,7 +33,7 @@ class ScriptedOpenerConfig:
     other within ``rechoose_grasp_m`` (CAPT's grasp point on a washing machine's door can jump between
     looks: on seeds 2 and 4 the orientation was chosen again on three looks running and the fingers
     then closed on nothing; 2, the default since session 20, opened 5 more of 200 washing machines with
-    CAPT than 1, within one of 1 on the other categories). The fingers
+    CAPT than 1, 2 more ovens, as many laptops and one cabinet door fewer). The fingers
     approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched fingertip
     off the surface a handle stands on, but under 6 cm a finger pitched across a drawer's bar clips its
     edge when the grasp point is half a centimetre off). Moves are capped at ``max_step_m`` /
