@@ -150,7 +150,7 @@ class ScriptedOpener:
         self._grasp_u: np.ndarray | None = None
         self._target_r: np.ndarray | None = None
         self._target_for: np.ndarray | None = None  # the grasp point _target_r was chosen for
-        self._looks: list[np.ndarray] = []  # the grasp points seen since, one per new estimate
+        self._looks: list[np.ndarray] = []  # the last rechoose_looks grasp points seen, one per new estimate
         self._swap_this_grasp = False  # this grasp turns the fingers the other way round
         self._pregrasp_steps = 0  # steps this grasp has spent in PREGRASP, moves started over included
         self._lid = False
@@ -199,8 +199,9 @@ class ScriptedOpener:
             return False
         point = np.asarray(est.grasp_point, dtype=np.float64)
         if not self._looks or float(np.linalg.norm(point - self._looks[-1])) > 1e-9:
-            self._looks.append(point.copy())  # a new look
-        recent = self._looks[-cfg.rechoose_looks:]
+            # a new look; only the last rechoose_looks are ever compared
+            self._looks = [*self._looks, point.copy()][-cfg.rechoose_looks:]
+        recent = self._looks
         if len(recent) < cfg.rechoose_looks:
             return False
         target_for = self._target_for

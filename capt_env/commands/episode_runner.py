@@ -36,6 +36,16 @@ class EpisodeJob:
     opener: ScriptedOpenerConfig | None
     max_steps: int
 
+    def identity(self) -> dict[str, Any]:
+        """What makes two evaluations the same (the key of :class:`EpisodeLog` records): everything
+        that decides an episode given its seed."""
+        from perception.yaml_config import to_dict
+
+        return {"category": self.category, "policy": self.policy, "model": self.model,
+                "perception": self.wrapper["source"], "checkpoint": self.wrapper.get("checkpoint"),
+                "every_k_steps": self.wrapper["every_k_steps"], "max_steps": self.max_steps,
+                "task": self.task, "opener": None if self.opener is None else to_dict(self.opener)}
+
     def build(self) -> tuple[Any, Any]:
         """A fresh wrapped env and policy."""
         from agents.scripted.rollout import make_env

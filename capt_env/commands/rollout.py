@@ -96,14 +96,8 @@ def run(args: argparse.Namespace) -> int:
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
                 obs_mode = "pointcloud"
             model = _model(args, category)
-            log = None
-            if args.episode_log is not None:
-                log = EpisodeLog(args.episode_log, {
-                    "category": category, "policy": args.policy, "model": model, "perception": source,
-                    "checkpoint": wrapper.get("checkpoint"), "every_k_steps": args.every_k_steps,
-                    "max_steps": args.max_steps, "task": task,
-                    "opener": None if opener is None else to_dict(opener)})
             job = EpisodeJob(category, wrapper, task, obs_mode, args.policy, model, opener, args.max_steps)
+            log = None if args.episode_log is None else EpisodeLog(args.episode_log, job.identity())
             episodes = play_episodes(job, seeds, args.workers, log, desc=f"{category} {source}")
             wins = sum(e.success for e in episodes)
             lo, hi = wilson_interval(wins, len(episodes))
