@@ -72,7 +72,11 @@ class ScriptedOpenerConfig:
     the handle would slide out of the fingers and a re-grasp would chase an open drawer; gripped at
     ``prismatic_approach_pitch`` 0.3 rad the handle slides out sooner, the hand slowing only to 0.6-0.8
     of its speed: with 0.6, 63 of 200 drawer episodes ran 30 or more steps longer, the stop missed and
-    the open drawer grasped twice more, seeds 4, 5, 8). After release it
+    the open drawer grasped twice more, seeds 4, 5, 8). When that brake is missed all the same (the
+    handle slid out of the fingers at the end stop while the hand kept its speed), a slip from a
+    prismatic part whose state, by the hand's own measure, is past ``prismatic_stop_above`` m (0: off)
+    also ends the pull for good: the re-grasp's approach pushed the open drawer back in (CAPT seeds
+    34, 54, 119: pulled 100% open, slipped, then 21-42% open at the end). After release it
     backs off ``retreat_distance`` m. With ``regrasp_other_fingers``, fingers that close on nothing (gap
     below ``hold_gap``; not a lid's) open, back off and grasp again with the fingers the other way round
     (a re-grasp): for a low handle one of the two finger orders can leave a wrist joint at its limit short
@@ -169,6 +173,7 @@ class ScriptedOpenerConfig:
     retreat_distance: float = 0.08
     fall_open_done: float = 1.3
     revolute_stop_above: float = 1.4
+    prismatic_stop_above: float = 0.15
     settle_above: float = 0.8
     settle_clearance: float = 0.1
     settle_window: int = 10
@@ -225,6 +230,8 @@ class ScriptedOpenerConfig:
                 f"fall_open_done must be >= 0 rad (0: off), got {self.fall_open_done}")
         require(self.revolute_stop_above >= 0,
                 f"revolute_stop_above must be >= 0 rad (0: off), got {self.revolute_stop_above}")
+        require(self.prismatic_stop_above >= 0,
+                f"prismatic_stop_above must be >= 0 m (0: off), got {self.prismatic_stop_above}")
         require(self.settle_above >= 0, f"settle_above must be >= 0 rad, got {self.settle_above}")
         require(self.settle_clearance >= 0,
                 f"settle_clearance must be >= 0 m, got {self.settle_clearance}")

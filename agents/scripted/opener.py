@@ -45,10 +45,10 @@ have closed on nothing (their gap, from the Panda's qpos, below ``hold_gap``), i
 if pulling stalls short of the target (a slipping grip, or the arm's range), it releases, retreats
 and goes back to 1 from the part's new pose (re-grasps are bounded by ``max_regrasps``). A prismatic
 part that brakes the pulling hand (see ``limit_slowdown``) has reached its end stop: the hand
-releases, retreats and is done. A door that gravity opens
-(:func:`~agents.scripted.grasp_pose.falls_open`, an oven door) is not grasped again once the hand
-loses it past ``fall_open_done``; short of that, the open hand moves out of the door's sweep and
-waits while it falls, then is done or grasps again (``RETREAT``).
+releases, retreats and is done; so has one that slips from the hand past ``prismatic_stop_above``.
+A door that gravity opens (:func:`~agents.scripted.grasp_pose.falls_open`, an oven door) is not
+grasped again once the hand loses it past ``fall_open_done``; short of that, the open hand moves
+out of the door's sweep and waits while it falls, then is done or grasps again (``RETREAT``).
 """
 
 from __future__ import annotations
@@ -559,6 +559,13 @@ class ScriptedOpener:
             self._grasp_again = est.state < cfg.fall_open_done and self.regrasps < cfg.max_regrasps
             self.regrasps += int(self._grasp_again)
             self._let_go_state = float(est.state)
+            self._set(Phase.RELEASE)
+            return hold(GRIPPER_OPEN)
+        if self._slip_count >= cfg.slip_steps and not revolute and 0.0 < cfg.prismatic_stop_above <= state:
+            # off the handle of a drawer pulled far out: it ran to its end stop and the brake was
+            # missed; reaching for the handle again would push the open drawer back in
+            self._grasp_again = False
+            self._let_go_state = state
             self._set(Phase.RELEASE)
             return hold(GRIPPER_OPEN)
         if self._slip_count >= cfg.slip_steps and self.regrasps < cfg.max_regrasps:

@@ -419,6 +419,40 @@ def test_a_side_door_held_far_open_that_stalls_is_at_its_stop() -> None:
         assert opener._grasp_again and opener.regrasps == 1, (state, gap)
 
 
+def _drawer_slipped_at(stop_at: float, cfg: ScriptedOpenerConfig) -> ScriptedOpener:
+    """An opener pulling the closed drawer at 5 mm a step (no braking), the handle sliding out of the
+    fingers when the drawer stops ``stop_at`` m open, until the pull ends."""
+    est = _closed_drawer()
+    rot = grasp_rotation(est, np.eye(3), cfg)
+    opener = ScriptedOpener(cfg)
+    opener.act_on(est, _pose(rot, est.grasp_point))
+    opener._start_pull(est.grasp_point, rot, est)
+    for k in range(1, 80):
+        hand = 0.005 * k
+        drawer = min(hand, stop_at)
+        seen = JointAxisEstimate("prismatic", est.direction, est.pivot, drawer,
+                                 est.grasp_point + est.direction * drawer)
+        opener.act_on(seen, _pose(rot, est.grasp_point + est.direction * hand),
+                      finger_gap=0.02 if hand <= stop_at else 0.0)
+        if opener.phase != Phase.PULL:
+            return opener
+    raise AssertionError("the pull did not end")
+
+
+def test_a_drawer_that_slips_out_far_open_is_at_its_stop() -> None:
+    cfg = ScriptedOpenerConfig()
+    far = cfg.prismatic_stop_above + 0.1
+    opener = _drawer_slipped_at(far, cfg)
+    assert opener.phase == Phase.RELEASE and not opener._grasp_again and opener.regrasps == 0
+    for _ in range(cfg.release_steps):
+        opener.act_on(_closed_drawer(), _pose(np.eye(3), np.zeros(3)))
+    assert opener.phase == Phase.RETREAT
+    # a slip near closed, or with the option off, grasps again
+    for stop_at, config in ((0.02, cfg), (far, ScriptedOpenerConfig(prismatic_stop_above=0.0))):
+        opener = _drawer_slipped_at(stop_at, config)
+        assert opener.phase == Phase.PREGRASP and opener.regrasps == 1, stop_at
+
+
 def test_doors_and_drawers_are_not_lids() -> None:
     cfg = ScriptedOpenerConfig()
     door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]), 0.0,
@@ -484,6 +518,8 @@ def test_bad_opener_config_is_rejected() -> None:
         from_dict(ScriptedOpenerConfig, {"fall_open_done": -1.0})
     with pytest.raises(ConfigError, match="revolute_stop_above"):
         from_dict(ScriptedOpenerConfig, {"revolute_stop_above": -0.5})
+    with pytest.raises(ConfigError, match="prismatic_stop_above"):
+        from_dict(ScriptedOpenerConfig, {"prismatic_stop_above": -0.1})
     with pytest.raises(ConfigError, match="settle_window"):
         from_dict(ScriptedOpenerConfig, {"settle_window": 0})
     with pytest.raises(ConfigError, match="rechoose_grasp_m"):
@@ -621,6 +657,21 @@ def test_a_drawer_at_its_end_stop_is_released_not_grasped_again() -> None:
     opener = ScriptedOpener()
     try:
         result = run_episode(env, opener, seed=4, max_steps=200)
+    finally:
+        env.close()
+    assert result.success and result.phase == "done", result
+    assert opener.regrasps == 0
+    assert result.steps < 150
+
+
+def test_a_drawer_that_slid_out_of_the_fingers_at_its_end_stop_is_left_open() -> None:
+    """Drawer seed 15 runs to its end stop and the bar slides out of the fingers before the brake is
+    read; the slip, 0.32 m out, ends the opening (before, two re-grasps pushed it back in and pulled
+    it out again, to the 200-step limit)."""
+    env = make_env("drawer_cabinet", {"source": "oracle"})
+    opener = ScriptedOpener()
+    try:
+        result = run_episode(env, opener, seed=15, max_steps=200)
     finally:
         env.close()
     assert result.success and result.phase == "done", result
