@@ -33,7 +33,11 @@ class ScriptedOpenerConfig:
     other within ``rechoose_grasp_m`` (CAPT's grasp point on a washing machine's door can jump between
     looks: on seeds 2 and 4 the orientation was chosen again on three looks running and the fingers
     then closed on nothing; 2, the default since session 20, opened 5 more of 200 washing machines with
-    CAPT than 1, 2 more ovens, as many laptops and one cabinet door fewer). The fingers
+    CAPT than 1, 2 more ovens, as many laptops and one cabinet door fewer). With
+    ``rechoose_part_kind`` the orientation is also chosen again, in those steps and on those looks,
+    when the part's kind (:func:`~agents.scripted.grasp_pose.part_kind`: lid, side door, other hinge)
+    differs from the one it was chosen for: a first look that tilts a door's hinge into a lid's sent
+    the hand to the door's top edge (cabinet door seed 3 with CAPT). The fingers
     approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched fingertip
     off the surface a handle stands on, but under 6 cm a finger pitched across a drawer's bar clips its
     edge when the grasp point is half a centimetre off). Moves are capped at ``max_step_m`` /
@@ -132,6 +136,7 @@ class ScriptedOpenerConfig:
     rechoose_grasp_m: float = 0.05
     rechoose_steps: int = 30
     rechoose_looks: int = 2
+    rechoose_part_kind: bool = False
     max_step_m: float = 0.03
     max_step_rad: float = 0.15
     pos_tolerance: float = 0.012

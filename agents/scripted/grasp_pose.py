@@ -41,6 +41,17 @@ def is_lid(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
     return float(outward_normal(est)[2]) >= float(np.cos(cfg.lid_max_tilt))
 
 
+def part_kind(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> str:
+    """The kind of part ``est`` describes, which decides how it is grasped: ``"prismatic"``,
+    ``"lid"`` (:func:`is_lid`), ``"vertical_hinge"`` (:func:`is_vertical_hinge`) or ``"hinge"``
+    (any other revolute part, e.g. an oven door)."""
+    if est.joint_type != "revolute":
+        return "prismatic"
+    if is_lid(est, cfg):
+        return "lid"
+    return "vertical_hinge" if is_vertical_hinge(est, cfg) else "hinge"
+
+
 def falls_open(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
     """Whether ``est`` is a part that gravity opens further once it is let go: a revolute part about
     a non-vertical hinge whose grasp point, closed (turned back by the estimated state), is above

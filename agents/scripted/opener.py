@@ -76,6 +76,7 @@ from agents.scripted.grasp_pose import (
     is_lid,
     is_vertical_hinge,
     lift_pose,
+    part_kind,
 )
 from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
 from agents.scripted.panda_kinematics import PANDA_LOWER, PANDA_UPPER, pose_matrix
@@ -151,6 +152,9 @@ class ScriptedOpener:
         self._target_r: np.ndarray | None = None
         self._target_for: np.ndarray | None = None  # the grasp point _target_r was chosen for
         self._looks: list[np.ndarray] = []  # the last rechoose_looks grasp points seen, one per new estimate
+        self._kind_for: str | None = None  # the part_kind _target_r was chosen for
+        self._kinds: list[str] = []  # the part_kind of the last rechoose_looks looks since then
+        self._kind_key: np.ndarray | None = None  # the last look's grasp point and direction
         self._swap_this_grasp = False  # this grasp turns the fingers the other way round
         self._pregrasp_steps = 0  # steps this grasp has spent in PREGRASP, moves started over included
         self._lid = False
@@ -208,6 +212,19 @@ class ScriptedOpener:
         return all(float(np.linalg.norm(q - target_for)) > cfg.rechoose_grasp_m for q in recent) and all(
             float(np.linalg.norm(q - recent[-1])) <= cfg.rechoose_grasp_m for q in recent)
 
+    def _part_kind_changed(self, est: JointAxisEstimate) -> bool:
+        """Whether, with ``rechoose_part_kind``, ``est`` shows another :func:`part_kind` than the
+        estimate the grasp orientation was chosen for, on each of the last ``rechoose_looks`` looks
+        (a first look can tilt a door's hinge into a lid's: the hand then went for the door's top
+        edge, cabinet door seed 3)."""
+        if not self.cfg.rechoose_part_kind or self._kind_for is None:
+            return False
+        key = np.concatenate([est.grasp_point, est.direction]).astype(np.float64)
+        if self._kind_key is None or float(np.abs(key - self._kind_key).max()) > 1e-9:  # a new look
+            self._kind_key = key
+            self._kinds = [*self._kinds, part_kind(est, self.cfg)][-self.cfg.rechoose_looks:]
+        return len(self._kinds) >= self.cfg.rechoose_looks and all(k != self._kind_for for k in self._kinds)
+
     def _reached(self, p: np.ndarray, perr: float, rerr: float) -> bool:
         """A move ends at the goal, on timeout, or when blocked (TCP still for ``blocked_steps``)."""
         moved = self._last_p is None or abs(perr - self._last_err[0]) > 0.002 or (
@@ -252,7 +269,8 @@ class ScriptedOpener:
                 return hold(GRIPPER_OPEN)
             if self.phase == Phase.PREGRASP:
                 self._pregrasp_steps += 1
-                if (self._pregrasp_steps <= cfg.rechoose_steps and self._grasp_point_moved(est)):
+                if self._pregrasp_steps <= cfg.rechoose_steps and (
+                        self._grasp_point_moved(est) or self._part_kind_changed(est)):
                     # a different grasp point: choose again and start the move over (early in the
                     # move only: a part seen open jumps about from look to look, and each start over
                     # turns the hand first)
@@ -268,6 +286,7 @@ class ScriptedOpener:
                     self._target_r = self._target_r @ SWAP_FINGERS
                 self._target_for = np.array(est.grasp_point, dtype=np.float64)
                 self._looks = [self._target_for.copy()]
+                self._kind_for, self._kinds = part_kind(est, cfg), []
                 self._lid = is_lid(est, cfg)
             lift = lift_pose(est, r, cfg, under=self.phase != Phase.PREGRASP) if self._lift else None
             if lift is not None:

@@ -16,11 +16,12 @@ from agents.scripted.grasp_pose import (
     is_lid,
     lift_pose,
     outward_normal,
+    part_kind,
 )
 from agents.scripted.opener import ACTION_SCALE_M, Phase
 from agents.scripted.panda_kinematics import tcp_pose
 from agents.scripted.rollout import make_env, run_episode
-from capt_env.wrappers.estimate import JointAxisEstimate
+from capt_env.wrappers.estimate import JointAxisEstimate, unit
 from perception.yaml_config import ConfigError, from_dict
 
 
@@ -609,6 +610,35 @@ def test_with_rechoose_looks_the_grasp_orientation_follows_only_a_grasp_point_se
     assert opener.phase_steps == 1
     with pytest.raises(ConfigError, match="rechoose_looks"):
         from_dict(ScriptedOpenerConfig, {"rechoose_looks": 0})
+
+
+def test_with_rechoose_part_kind_a_door_first_seen_as_a_lid_is_grasped_as_a_door() -> None:
+    # cabinet door seed 3 with CAPT: the first look tilted the side door's hinge into a lid's and the
+    # hand went for the door's top edge; with rechoose_part_kind two looks at a side door choose again
+    grasp_point = np.array([0.1, 0.15, 0.2])
+    lid = JointAxisEstimate("revolute", np.array([0.0, 1.0, 0.0]), np.array([0.3, 0.0, 0.2]), 0.0,
+                            grasp_point)
+    door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([0.1, -0.2, 0.2]), 0.0,
+                             grasp_point)
+    door_again = JointAxisEstimate("revolute", unit(np.array([0.0, 0.01, 1.0])), door.pivot, 0.0, grasp_point)
+    away = np.array([-0.2, 0.0, 0.4, 0.0, 1.0, 0.0, 0.0])
+    r = Rotation.from_quat(away[3:], scalar_first=True).as_matrix()
+    assert ScriptedOpenerConfig().rechoose_part_kind is False  # not the default yet
+    for on in (True, False):
+        cfg = ScriptedOpenerConfig(rechoose_part_kind=on)
+        kinds = [part_kind(e, cfg) for e in (lid, door, door_again)]
+        assert kinds == ["lid", "vertical_hinge", "vertical_hinge"]
+        opener = ScriptedOpener(cfg)
+        opener.act_on(lid, away)
+        assert opener._lid
+        opener.act_on(door, away)  # one look at a side door: not yet
+        assert opener._lid and opener.phase_steps == 2
+        opener.act_on(door_again, away)  # the next look agrees
+        assert opener._lid is not on
+        if on:
+            assert opener.phase_steps == 1
+            np.testing.assert_allclose(opener._target_r, grasp_rotation(door_again, r, cfg), atol=1e-9)
+    assert part_kind(_closed_drawer(), cfg) == "prismatic" and part_kind(_oven(), cfg) == "hinge"
 
 
 def test_the_finger_order_the_wrist_cannot_reach_is_rehearsed_and_not_taken() -> None:
