@@ -36,12 +36,13 @@ SHIPPED_OPENERS = {
                "wrist_limit_margin": 0.05, "lid_lift_inward": 0.02, "lid_lift_lead": 0.2,
                "fall_open_done": 1.3, "revolute_stop_above": 0.0, "rehearse_fingers": False,
                "rechoose_grasp_m": 0.0, "watch_falling": False, "prismatic_approach_pitch": 0.55,
-               "prismatic_stop_above": 0.0},
+               "prismatic_stop_above": 0.0, "rechoose_part_kind": False},
     "drawer_cabinet": {"arc_fit": True, "regrasp_other_fingers": True, "approach_gap": 0.06,
                        "wrist_limit_margin": 0.05, "lid_lift_lead": 0.12, "fall_open_done": 0.0,
                        "revolute_stop_above": 0.0, "rehearse_fingers": False,
                        "rechoose_grasp_m": 0.0, "watch_falling": False,
-                       "prismatic_approach_pitch": 0.55, "prismatic_stop_above": 0.0},
+                       "prismatic_approach_pitch": 0.55, "prismatic_stop_above": 0.0,
+                       "rechoose_part_kind": False},
 }
 
 
