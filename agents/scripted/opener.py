@@ -271,7 +271,7 @@ class ScriptedOpener:
                 self._pregrasp_steps += 1
                 if self._pregrasp_steps <= cfg.rechoose_steps and (
                         self._grasp_point_moved(est) or self._part_kind_changed(est)):
-                    # a different grasp point: choose again and start the move over (early in the
+                    # a different grasp point or part kind: choose again and start the move over (early in the
                     # move only: a part seen open jumps about from look to look, and each start over
                     # turns the hand first)
                     self.phase_steps = 1
