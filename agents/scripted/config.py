@@ -77,7 +77,7 @@ class ScriptedOpenerConfig:
     ``prismatic_approach_pitch`` 0.3 rad the handle slides out sooner, the hand slowing only to 0.6-0.8
     of its speed: with 0.6, 63 of 200 drawer episodes ran 30 or more steps longer, the stop missed and
     the open drawer grasped twice more, seeds 4, 5, 8). When that brake is missed all the same (the
-    handle slid out of the fingers at the end stop while the hand kept its speed), a slip from a
+    handle slid out of the fingers at the end stop before the hand's slowing was read), a slip from a
     prismatic part whose state, by the hand's own measure, is past ``prismatic_stop_above`` m (0: off)
     also ends the pull for good: the re-grasp's approach pushed the open drawer back in (CAPT seeds
     34, 54, 119: pulled 100% open, slipped, then 21-42% open at the end). After release it

@@ -287,7 +287,7 @@ class ScriptedOpener:
                 self._target_for = np.array(est.grasp_point, dtype=np.float64)
                 self._looks = [self._target_for.copy()]
                 self._kind_for, self._kinds = part_kind(est, cfg), []
-                self._lid = is_lid(est, cfg)
+                self._lid = self._kind_for == "lid"
             lift = lift_pose(est, r, cfg, under=self.phase != Phase.PREGRASP) if self._lift else None
             if lift is not None:
                 goal, self._target_r = lift
