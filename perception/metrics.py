@@ -13,6 +13,9 @@ Conventions:
 - mIoU averages the IoU over the parts that occur in the ground truth or the prediction of that sample
   (points with ground truth -1 are ignored).
 - AP x = share of results with error strictly below x.
+- Beyond the paper, each summary also has the median direction error and the share of axes that
+  point the other way (``dir_flipped``: error over 90 degrees): a few whole sign flips can carry a
+  mean error whose median is a fraction of a degree.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 DIR_THRESHOLDS_DEG = (5.0, 10.0)
+FLIPPED_ABOVE_DEG = 90.0
 POS_THRESHOLDS = (0.01, 0.05)
 STATE_THRESHOLDS_DEG = (5.0, 10.0)
 STATE_THRESHOLDS_M = (0.01, 0.05)
@@ -108,13 +112,21 @@ class SampleResult:
     time_ms: float | None = None
 
 
+def _share_above(errors: Sequence[float], threshold: float) -> float:
+    """Share of errors strictly above ``threshold`` (NaN when there are none)."""
+    e = np.asarray(errors, dtype=np.float64)
+    return float((e > threshold).mean()) if len(e) else float("nan")
+
+
 def _mean(xs: Sequence[float | None]) -> float:
     v = [x for x in xs if x is not None and not math.isnan(x)]
     return float(np.mean(v)) if v else float("nan")
 
 
 def summarise(results: Sequence[SampleResult]) -> dict[str, float | list[float]]:
-    """Aggregate one (category, method) group: scalars for segmentation/time, per-joint lists otherwise."""
+    """Aggregate one (category, method) group: scalars for segmentation/time, per-joint lists otherwise
+    (the paper's columns, then ``dir_median`` in degrees and ``dir_flipped``, the share of direction
+    errors over :data:`FLIPPED_ABOVE_DEG`)."""
     out: dict[str, float | list[float]] = {
         "pa": _mean([r.pa for r in results]),
         "miou": _mean([r.miou for r in results]),
@@ -122,7 +134,7 @@ def summarise(results: Sequence[SampleResult]) -> dict[str, float | list[float]]
     }
     num_joints = max((len(r.joints) for r in results), default=0)
     keys = ["dir_med", "dir_ap5", "dir_ap10", "pos_aed", "pos_ap1", "pos_ap5", "state_med", "state_ap5",
-            "state_ap10"]
+            "state_ap10", "dir_median", "dir_flipped"]
     cols: dict[str, list[float]] = {k: [] for k in keys}
     for k in range(num_joints):
         js = [r.joints[k] for r in results if len(r.joints) > k]
@@ -133,7 +145,8 @@ def summarise(results: Sequence[SampleResult]) -> dict[str, float | list[float]]
         vals = [_mean(d), average_precision(d, DIR_THRESHOLDS_DEG[0]),
                 average_precision(d, DIR_THRESHOLDS_DEG[1]),
                 _mean(p), average_precision(p, POS_THRESHOLDS[0]), average_precision(p, POS_THRESHOLDS[1]),
-                _mean(s), average_precision(s, st[0]), average_precision(s, st[1])]
+                _mean(s), average_precision(s, st[0]), average_precision(s, st[1]),
+                float(np.median(d)) if d else float("nan"), _share_above(d, FLIPPED_ABOVE_DEG)]
         for key, v in zip(keys, vals, strict=True):
             cols[key].append(v)
     out.update(cols)

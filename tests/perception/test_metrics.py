@@ -67,6 +67,11 @@ def test_summarise_and_table():
     assert s["pos_aed"] == [pytest.approx(0.0175)]
     assert s["pos_ap1"] == [0.5] and s["pos_ap5"] == [1.0]
     assert s["state_ap5"] == [0.5] and s["state_ap10"] == [0.5]
+    assert s["dir_median"] == [pytest.approx(5.0)] and s["dir_flipped"] == [0.0]
+    flips = summarise([_result(0.2, 0.005, 1.0), _result(0.4, 0.005, 1.0), _result(179.0, 0.005, 1.0)])
+    assert flips["dir_median"] == [pytest.approx(0.4)]
+    assert flips["dir_flipped"] == [pytest.approx(1 / 3)]
+    assert flips["dir_med"] == [pytest.approx(179.6 / 3)]  # the paper's mean, carried by the flip
     prism = SampleResult("drawer", "capt", None, None, (JointResult(0, "prismatic", 1.0, None, None, 0.02),))
     table = table_markdown([*rs, prism])
     lines = table.splitlines()
