@@ -99,6 +99,20 @@ def test_demo_estimates_an_unseen_object_with_the_shipped_checkpoint(tmp_path: P
     assert episode["direction_deg"] < 20.0 and episode["position_m"] < 0.05
 
 
+def test_demo_estimates_eyeglasses_without_opening_them(tmp_path: Path, capsys) -> None:
+    """Eyeglasses are not among the opener's categories: the demo estimates them and says so."""
+    from capt_env.commands.demo import OPENED_CATEGORIES
+
+    out = tmp_path / "demo.json"
+    assert "eyeglasses" not in OPENED_CATEGORIES and "oven" in OPENED_CATEGORIES
+    assert main(["demo", "--category", "eyeglasses", "--episodes", "1", "--out", str(tmp_path),
+                 "--json", str(out)]) == 0
+    (episode,) = json.loads(out.read_text())["episodes"]
+    assert "success" not in episode and episode["not_opened"].startswith("estimate only")
+    assert "mp4" not in episode and Path(episode["png"]).is_file()
+    assert "estimate only" in capsys.readouterr().out
+
+
 def test_estimate_errors_on_constructed_estimates() -> None:
     import numpy as np
 
