@@ -71,7 +71,8 @@ def test_shipped_configs_load() -> None:
 
     root = Path(__file__).resolve().parents[1] / "configs"
     for path in sorted((root / "generate").glob("*.yaml")):
-        assert load_yaml(GenerateConfig, path).category == path.stem
+        category = load_yaml(GenerateConfig, path).category
+        assert path.stem == category or path.stem.startswith(f"{category}_")
     for path in sorted((root / "tasks").glob("*.yaml")):
         raw = yaml.safe_load(path.read_text())
         if "category" in raw or "object" in raw:
@@ -80,3 +81,23 @@ def test_shipped_configs_load() -> None:
             overrides = task_overrides(str(path))
             config = from_dict(TaskConfig, {"category": "oven", **overrides}, where=str(path))
             assert set(overrides) <= set(to_dict(config))
+
+
+def test_larger_generate_configs_share_their_base_val_and_test_shards() -> None:
+    """``<category>_<n>.yaml`` only adds training clouds: every setting but the train count is its base
+    config's, so its val and test shards (a pure function of seed, split and index) are the same."""
+    import dataclasses
+
+    from capt_env.dataset.config import GenerateConfig
+    from capt_env.dataset.generator import plan_shards
+
+    root = Path(__file__).resolve().parents[1] / "configs" / "generate"
+    larger = [p for p in sorted(root.glob("*.yaml")) if p.stem != load_yaml(GenerateConfig, p).category]
+    assert larger, "expected at least one larger dataset config"
+    for path in larger:
+        big = load_yaml(GenerateConfig, path)
+        base = load_yaml(GenerateConfig, root / f"{big.category}.yaml")
+        assert big.counts["train"] > base.counts["train"]
+        assert dataclasses.replace(big, counts=base.counts) == base
+        held_out = [j for j in plan_shards(big) if j.split != "train"]
+        assert held_out == [j for j in plan_shards(base) if j.split != "train"]
