@@ -7,7 +7,7 @@ then run the scripted opening policy on CAPT's estimates and save an MP4 of the 
 
 Only the categories the opener is measured on (``OPENED_CATEGORIES``, as in ``capt rollout``'s
 benchmarks) are opened; eyeglasses are estimated only: the scripted opener was never built or
-measured for unfolding a temple a few millimetres thick, and failed it every time it was tried.
+measured for unfolding a temple a few millimetres thick, and failed it on every recorded demo run.
 """
 
 from __future__ import annotations
