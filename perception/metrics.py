@@ -81,9 +81,13 @@ def state_error(pred: float, gt: float, joint_type: str) -> float:
     return math.degrees(err) if joint_type == "revolute" else err
 
 
+def _finite(errors: Sequence[float | None]) -> np.ndarray:
+    return np.asarray([x for x in errors if x is not None and not math.isnan(x)], dtype=np.float64)
+
+
 def average_precision(errors: Sequence[float], threshold: float) -> float:
     """Share of errors strictly below ``threshold`` (NaN when there are none)."""
-    e = np.asarray([x for x in errors if x is not None and not math.isnan(x)], dtype=np.float64)
+    e = _finite(errors)
     return float((e < threshold).mean()) if len(e) else float("nan")
 
 
@@ -114,7 +118,7 @@ class SampleResult:
 
 def _share_above(errors: Sequence[float], threshold: float) -> float:
     """Share of errors strictly above ``threshold`` (NaN when there are none)."""
-    e = np.asarray(errors, dtype=np.float64)
+    e = _finite(errors)
     return float((e > threshold).mean()) if len(e) else float("nan")
 
 

@@ -94,13 +94,13 @@ def run(args: argparse.Namespace) -> int:
             for ep in range(args.episodes):
                 tag = f"{category}_episode{ep}"
                 row = {"category": category, **estimate_episode(env, estimator, args.seed + ep, out_dir, tag)}
-                if not args.no_policy and category not in OPENED_CATEGORIES:
-                    row["not_opened"] = "estimate only: the scripted opener is not built for this category"
-                elif not args.no_policy:
+                if not args.no_policy and category in OPENED_CATEGORIES:
                     from capt_env.commands.demo_policy import open_with_capt
 
                     row.update(open_with_capt(category, ckpt, args.seed + ep, out_dir, tag,
                                               video=not args.no_video, task=overrides))
+                elif not args.no_policy:
+                    row["not_opened"] = "estimate only: the scripted opener is not built for this category"
                 report.append(row)
                 pos = "-" if row["position_m"] is None else f"{100 * row['position_m']:.1f} cm"
                 opened = ""
