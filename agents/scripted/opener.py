@@ -570,7 +570,10 @@ class ScriptedOpener:
                 self._other_fingers = True
             self._set(Phase.RELEASE)
             return hold(GRIPPER_CLOSE)
-        far = np.linalg.norm(p - est.grasp_point) > cfg.slip_distance and not holding
+        away = p - np.asarray(est.grasp_point, dtype=np.float64)
+        if self._lid and revolute and cfg.lid_slip_off_axis:
+            away = off_axis(away, u)  # along its hinge, a lid's far edge is all the same to the hand
+        far = float(np.linalg.norm(away)) > cfg.slip_distance and not holding
         self._slip_count = self._slip_count + 1 if far else 0
         if self._slip_count >= cfg.slip_steps and falls and est.state >= cfg.settle_above:
             # off the handle of a door that falls open: let go, clear it and wait (see RETREAT)

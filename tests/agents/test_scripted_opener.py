@@ -104,6 +104,33 @@ def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_
 
 
 
+def _lid_pull_after(seen_offset: np.ndarray, cfg: ScriptedOpenerConfig) -> ScriptedOpener:
+    """An opener lifting the closed laptop's lid from below, held 0.5 rad open for ``slip_steps`` + 2
+    steps while the perceived grasp point sits ``seen_offset`` (3,) m from the hand."""
+    est = _closed_laptop()
+    start = est.grasp_point - np.array([0.0, 0.0, 0.01])
+    now = est.pivot + axis_angle_matrix(est.direction, 0.5) @ (start - est.pivot)
+    opener = ScriptedOpener(cfg)
+    opener._lid = opener._lift = True
+    opener._start_pull(start, np.eye(3), est)
+    seen = JointAxisEstimate("revolute", est.direction, est.pivot, 0.5, now + seen_offset)
+    for _ in range(cfg.slip_steps + 2):
+        opener.act_on(seen, _pose(np.eye(3), now), finger_gap=0.0)
+    return opener
+
+
+def test_a_lid_grasp_point_sliding_along_the_hinge_is_not_a_slip() -> None:
+    # laptop seeds 6 and 38: the far edge's visible points, half hidden by the hand, put the grasp
+    # point 11-13 cm along the hinge from the hand mid-pull, and the re-grasps ran out the episode
+    along = np.array([0.0, 0.12, 0.0])
+    assert _lid_pull_after(along, ScriptedOpenerConfig()).phase == Phase.PULL
+    off = _lid_pull_after(along, ScriptedOpenerConfig(lid_slip_off_axis=False))
+    assert off.phase == Phase.PREGRASP and off.regrasps == 1
+    # off the lid's arc (the lid fell back under the hand) is a slip either way
+    below = _lid_pull_after(np.array([0.0, 0.0, -0.12]), ScriptedOpenerConfig())
+    assert below.phase == Phase.PREGRASP and below.regrasps == 1
+
+
 def test_a_lid_lifted_from_below_leads_by_lid_lift_lead_and_a_gripped_one_by_revolute_lead() -> None:
     est = _closed_laptop()
     hinge_y = est.direction
