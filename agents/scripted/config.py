@@ -70,12 +70,13 @@ class ScriptedOpenerConfig:
     the part's perceived grasp point for ``slip_steps`` steps (longer than the perception period, so one
     bad estimate, e.g. of a handle the hand now hides, is not a slip) and its fingers are less than
     ``hold_gap`` m apart (closed on nothing; a gap means they hold the handle, whatever the perceived
-    grasp point says). With ``lid_slip_off_axis``, a lid's slip distance leaves out its component along the
-    estimated hinge: a lid has no handle, and its grasp point (the mean of the far edge's visible
-    points) slides along the edge as the hand hides part of it (laptop seeds 6 and 38 with a
-    fine-tuned model: 11-13 cm along the hinge mid-pull read as a slip, and the re-grasps ran out the
-    episode at 58% and 5% open). Pulling a prismatic part ends for good, without a re-grasp, when the hand, having
-    pulled at a cruising speed of at least ``limit_min_speed_m`` m per step, moves less than
+    grasp point says). With ``lid_slip_off_axis``, a lid's slip distance leaves out its component
+    along the estimated hinge: a lid has no handle, and its grasp point (the mean of the far edge's
+    visible points) slides along the edge as the hand hides part of it (laptop seeds 6 and 38 with a
+    fine-tuned model: 11-13 cm along the hinge mid-pull read as a slip, and the re-grasps ran out
+    the episode at 58% and 5% open). Pulling a prismatic part ends for good, without a re-grasp,
+    when the hand, having pulled at a cruising speed of at least ``limit_min_speed_m`` m per step,
+    moves less than
     ``limit_slowdown`` of that speed for ``limit_window`` steps: the part has hit its end stop (pulled on,
     the handle would slide out of the fingers and a re-grasp would chase an open drawer; gripped at
     ``prismatic_approach_pitch`` 0.3 rad the handle slides out sooner, the hand slowing only to 0.6-0.8
