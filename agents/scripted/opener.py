@@ -571,7 +571,7 @@ class ScriptedOpener:
             self._set(Phase.RELEASE)
             return hold(GRIPPER_CLOSE)
         away = p - np.asarray(est.grasp_point, dtype=np.float64)
-        if self._lid and revolute and cfg.lid_slip_off_axis:
+        if self._lid and cfg.lid_slip_off_axis:  # a lid is revolute (part_kind)
             away = off_axis(away, u)  # along its hinge, a lid's far edge is all the same to the hand
         far = float(np.linalg.norm(away)) > cfg.slip_distance and not holding
         self._slip_count = self._slip_count + 1 if far else 0

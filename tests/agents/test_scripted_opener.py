@@ -103,7 +103,6 @@ def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_
     np.testing.assert_allclose(inward - plain, -0.02 * 0.62 * radial / np.linalg.norm(radial), atol=1e-6)
 
 
-
 def _lid_pull_after(seen_offset: np.ndarray, cfg: ScriptedOpenerConfig) -> ScriptedOpener:
     """An opener lifting the closed laptop's lid from below, held 0.5 rad open for ``slip_steps`` + 2
     steps while the perceived grasp point sits ``seen_offset`` (3,) m from the hand."""
