@@ -19,6 +19,7 @@ VERBS: dict[str, tuple[str, str]] = {
     "evaluate": ("evaluate", "the paper's Table I and time per input for checkpoints, side by side"),
     "train-ppo": ("train_ppo", "train PPO on joint-axis observations (train split), resumable"),
     "rollout": ("rollout", "success rate of the scripted policy per category and perception source"),
+    "noise-sweep": ("noise_sweep", "success rate against the size of one joint-estimate error"),
     "estimate-errors": ("estimate_errors", "errors of the wrapper's CAPT estimate on unseen env resets"),
     "bench": ("bench", "environment speed: steps/s in state and pointcloud mode, reset time"),
 }

@@ -39,12 +39,16 @@ class EpisodeJob:
     def identity(self) -> dict[str, Any]:
         """What makes two evaluations the same (the key of :class:`EpisodeLog` records): everything
         that decides an episode given its seed."""
-        from perception.yaml_config import to_dict
+        from capt_env.wrappers.config import NoiseConfig
+        from perception.yaml_config import from_dict, to_dict
 
-        return {"category": self.category, "policy": self.policy, "model": self.model,
-                "perception": self.wrapper["source"], "checkpoint": self.wrapper.get("checkpoint"),
-                "every_k_steps": self.wrapper["every_k_steps"], "max_steps": self.max_steps,
-                "task": self.task, "opener": None if self.opener is None else to_dict(self.opener)}
+        identity = {"category": self.category, "policy": self.policy, "model": self.model,
+                    "perception": self.wrapper["source"], "checkpoint": self.wrapper.get("checkpoint"),
+                    "every_k_steps": self.wrapper["every_k_steps"], "max_steps": self.max_steps,
+                    "task": self.task, "opener": None if self.opener is None else to_dict(self.opener)}
+        if self.wrapper["source"] == "noisy_oracle":  # every field, so a changed default is a new run
+            identity["noise"] = to_dict(from_dict(NoiseConfig, self.wrapper.get("noise", {}), where="noise"))
+        return identity
 
     def build(self) -> tuple[Any, Any]:
         """A fresh wrapped env and policy."""

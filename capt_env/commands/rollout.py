@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import asdict
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from capt_env.commands.episode_log import EpisodeLog
 from capt_env.commands.json_output import write_json
+from capt_env.commands.noise_overrides import add_noise_argument, noise_overrides, resolved_noise
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 from perception.yaml_config import to_dict
 
 if TYPE_CHECKING:
     from agents.scripted.config import ScriptedOpenerConfig
+    from agents.scripted.rollout import EpisodeResult
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -30,6 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--opener", default=None,
                         help="YAML of ScriptedOpenerConfig overrides (with --policy scripted), e.g. "
                              "configs/opener/steep_door_approach.yaml; default: the opener's defaults")
+    add_noise_argument(parser)
     add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
     parser.add_argument("--workers", type=int, default=1,
@@ -55,7 +58,7 @@ def opener_config(path: str | None) -> ScriptedOpenerConfig:
         raise SystemExit(f"--opener {path}: {err}") from err
 
 
-def _model(args: argparse.Namespace, category: str) -> str | None:
+def ppo_model(args: argparse.Namespace, category: str) -> str | None:
     """The PPO model file to evaluate (``--model``, else the category's shipped policy); None for the
     scripted opener."""
     if args.policy != "ppo":
@@ -68,10 +71,30 @@ def _model(args: argparse.Namespace, category: str) -> str | None:
         raise SystemExit(str(err)) from err
 
 
-def run(args: argparse.Namespace) -> int:
+def success_row(episodes: list[EpisodeResult]) -> dict[str, Any]:
+    """Success rate with its Wilson 95% interval, mean opened fraction and mean steps of
+    ``episodes``, and the episodes themselves."""
     import numpy as np
 
     from agents.success_stats import wilson_interval
+
+    wins = sum(e.success for e in episodes)
+    lo, hi = wilson_interval(wins, len(episodes))
+    return {"success_rate": wins / len(episodes), "ci95": [lo, hi],
+            "mean_open_fraction": float(np.mean([e.open_fraction for e in episodes])),
+            "mean_steps": float(np.mean([e.steps for e in episodes])),
+            "episodes": [asdict(e) for e in episodes]}
+
+
+def success_cells(row: dict[str, Any]) -> str:
+    """The Markdown cells ``success | 95% interval | mean opened | mean steps | episodes`` of a
+    :func:`success_row`."""
+    lo, hi = row["ci95"]
+    return (f"{row['success_rate']:.2f} | [{lo:.2f}, {hi:.2f}] | {row['mean_open_fraction']:.2f} | "
+            f"{row['mean_steps']:.0f} | {len(row['episodes'])}")
+
+
+def run(args: argparse.Namespace) -> int:
     from capt_env.commands.episode_runner import EpisodeJob, play_episodes
 
     header = "| category | perception | success | 95% interval | mean opened | mean steps | episodes |"
@@ -86,29 +109,28 @@ def run(args: argparse.Namespace) -> int:
         raise SystemExit(f"--workers must be at least 1, got {args.workers}")
     if args.episodes < 1:
         raise SystemExit(f"--episodes must be at least 1, got {args.episodes}")
+    noise = noise_overrides(args.noise)
+    if args.noise and "noisy_oracle" not in args.perception:
+        raise SystemExit("--noise sets the noisy_oracle source's noise; add noisy_oracle to --perception")
     for category in args.categories:
         for source in args.perception:
-            wrapper = {"source": source, "every_k_steps": args.every_k_steps}
+            wrapper: dict[str, Any] = {"source": source, "every_k_steps": args.every_k_steps}
+            if source == "noisy_oracle":
+                wrapper["noise"] = noise
             obs_mode = "state"
             if source == "capt":
                 from perception.checkpoints import default_checkpoint
 
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
                 obs_mode = "pointcloud"
-            model = _model(args, category)
+            model = ppo_model(args, category)
             job = EpisodeJob(category, wrapper, task, obs_mode, args.policy, model, opener, args.max_steps)
             log = None if args.episode_log is None else EpisodeLog(args.episode_log, job.identity())
             episodes = play_episodes(job, seeds, args.workers, log, desc=f"{category} {source}")
-            wins = sum(e.success for e in episodes)
-            lo, hi = wilson_interval(wins, len(episodes))
             row = {"category": category, "policy": args.policy, "model": model, "perception": source,
-                   "success_rate": wins / len(episodes), "ci95": [lo, hi],
-                   "mean_open_fraction": float(np.mean([e.open_fraction for e in episodes])),
-                   "mean_steps": float(np.mean([e.steps for e in episodes])),
-                   "episodes": [asdict(e) for e in episodes]}
+                   **success_row(episodes)}
             rows.append(row)
-            lines.append(f"| {category} | {source} | {row['success_rate']:.2f} | [{lo:.2f}, {hi:.2f}] | "
-                         f"{row['mean_open_fraction']:.2f} | {row['mean_steps']:.0f} | {len(episodes)} |")
+            lines.append(f"| {category} | {source} | {success_cells(row)} |")
     table = "\n".join(lines)
     print(table)
     if args.markdown:
@@ -119,6 +141,7 @@ def run(args: argparse.Namespace) -> int:
     write_json(args.json, {"seeds": seeds, "policy": args.policy, "max_steps": args.max_steps,
                            "workers": args.workers,
                            "every_k_steps": args.every_k_steps, "task": task,
+                           "noise": resolved_noise(noise) if "noisy_oracle" in args.perception else None,
                            "opener": None if opener is None else to_dict(opener),
                            "results": rows})
     return 0

@@ -10,6 +10,7 @@ from perception.yaml_config import require
 Source = Literal["oracle", "noisy_oracle", "capt"]
 IsolationMode = Literal["segmentation", "geometric"]
 ObsFormat = Literal["flat", "dict"]
+NoiseModel = Literal["gaussian", "fixed_offset"]
 
 
 @dataclass(frozen=True)
@@ -49,20 +50,31 @@ class IsolationConfig:
 
 @dataclass(frozen=True)
 class NoiseConfig:
-    """Noise of the ``noisy_oracle`` source: the axis direction is tilted by an angle drawn from
-    N(0, ``direction_rad``) (radians) about a random perpendicular axis; pivot and grasp point get
-    isotropic Gaussian offsets with per-axis std ``pivot_m`` / ``grasp_m`` (metres); the state gets
-    N(0, ``state``) (radians or metres). ``grasp_outward_m`` is a constant bias, not noise: the
-    grasp point moves that far (metres) along the part's opening direction at it (revolute: along the
-    radius from the axis; prismatic: along the axis), like an estimator whose grasp-point convention
-    differs from the ground truth's (CAPT puts a laptop's at the outer band of its lip's points, about
-    1.2 cm beyond the lip's centre)."""
+    """Noise of the ``noisy_oracle`` source, by ``model``:
+
+    - ``gaussian`` (redrawn at every estimate): the axis direction is tilted by an angle drawn from
+      N(0, ``direction_rad``) (radians) about a random perpendicular axis; pivot and grasp point get
+      isotropic Gaussian offsets with per-axis std ``pivot_m`` / ``grasp_m`` (metres); the state gets
+      N(0, ``state``) (radians or metres).
+    - ``fixed_offset`` (drawn once per episode, then held): an estimator with a consistent error of
+      exactly the given sizes. The direction is tilted by exactly ``direction_rad`` about a random
+      perpendicular axis; the axis line is moved ``pivot_m`` (metres) off the true one, in a random
+      direction perpendicular to it (the line distance is ``pivot_m`` when the tilt is zero); the
+      state is off by ``state`` with a random sign; the grasp point by ``grasp_m`` in a random
+      direction. Only the directions and signs are random, seeded per episode.
+
+    ``grasp_outward_m`` is a constant bias in both models: the grasp point moves that far (metres)
+    along the part's opening direction at it (revolute: along the radius from the axis; prismatic:
+    along the axis), like an estimator whose grasp-point convention differs from the ground truth's
+    (CAPT puts a laptop's at the outer band of its lip's points, about 1.2 cm beyond the lip's
+    centre)."""
 
     direction_rad: float = 0.05
     pivot_m: float = 0.01
     state: float = 0.02
     grasp_m: float = 0.005
     grasp_outward_m: float = 0.0
+    model: NoiseModel = "gaussian"
 
     def validate(self) -> None:
         for key in ("direction_rad", "pivot_m", "state", "grasp_m", "grasp_outward_m"):

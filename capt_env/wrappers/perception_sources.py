@@ -96,21 +96,27 @@ class OracleSource:
         return ground_truth_estimate(info)
 
 
+def _perpendicular(u: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """The unit component of ``r`` (3,) perpendicular to the unit ``u`` (3,)."""
+    return unit(r - (r @ u) * u)
+
+
 def tilt(direction: np.ndarray, angle: float, rng: np.random.Generator) -> np.ndarray:
     """``direction`` (3,) rotated by ``angle`` radians about a uniformly random perpendicular axis."""
     u = unit(direction)
-    r = rng.normal(size=3)
-    perp = unit(r - (r @ u) * u)
+    perp = _perpendicular(u, rng.normal(size=3))
     return np.cos(angle) * u + np.sin(angle) * perp
 
 
 class NoisyOracleSource:
-    """Ground truth plus Gaussian noise of the magnitudes in :class:`NoiseConfig`, seeded.
+    """Ground truth plus noise of the magnitudes in :class:`NoiseConfig`, seeded (see its models).
 
-    The direction is tilted by ``|N(0, direction_rad)|`` radians; the grasp point moves
-    ``grasp_outward_m`` along :func:`~capt_env.wrappers.estimate.away_from_joint`, plus noise; the
-    noisy pivot is then made canonical again (closest to the noisy grasp point) so only the off-axis
-    part of the pivot noise remains.
+    ``gaussian``: the direction is tilted by ``|N(0, direction_rad)|`` radians, the pivot, state and
+    grasp point get Gaussian offsets, all redrawn at every estimate. ``fixed_offset``: errors of
+    exactly the configured sizes, their directions and signs drawn at the first estimate after
+    :meth:`reset` and held until the next. In both, the grasp point moves ``grasp_outward_m`` along
+    :func:`~capt_env.wrappers.estimate.away_from_joint`, and the noisy pivot is then made canonical
+    again (closest to the noisy grasp point), so only the off-axis part of the pivot noise remains.
     """
 
     needs_points = False
@@ -118,15 +124,32 @@ class NoisyOracleSource:
     def __init__(self, noise: NoiseConfig, seed: int = 0) -> None:
         self.noise = noise
         self.rng = np.random.default_rng(seed)
+        self._held: dict[str, Any] | None = None  # fixed_offset: this episode's random directions
+
+    def reset(self) -> None:
+        """A new episode: ``fixed_offset`` draws new error directions at the next estimate."""
+        self._held = None
 
     def estimate(self, points: np.ndarray | None, info: dict[str, Any],
                  dense_points: np.ndarray | None = None) -> JointAxisEstimate:
         gt = ground_truth_estimate(info)
         n, rng = self.noise, self.rng
-        direction = tilt(gt.direction, abs(float(rng.normal(0.0, n.direction_rad))), rng)
-        grasp = gt.grasp_point + n.grasp_outward_m * away_from_joint(gt) + rng.normal(0.0, n.grasp_m, size=3)
-        pivot = canonical_pivot(direction, gt.pivot + rng.normal(0.0, n.pivot_m, size=3), grasp)
-        state = gt.state + float(rng.normal(0.0, n.state))
+        outward = n.grasp_outward_m * away_from_joint(gt)
+        if n.model == "fixed_offset":
+            if self._held is None:
+                self._held = {"tilt": rng.normal(size=3), "pivot": rng.normal(size=3),
+                              "grasp": unit(rng.normal(size=3)), "sign": float(rng.choice([-1.0, 1.0]))}
+            h, u = self._held, unit(gt.direction)
+            direction = np.cos(n.direction_rad) * u + np.sin(n.direction_rad) * _perpendicular(u, h["tilt"])
+            grasp = gt.grasp_point + outward + n.grasp_m * h["grasp"]
+            shifted = gt.pivot + n.pivot_m * _perpendicular(u, h["pivot"])
+            state = gt.state + h["sign"] * n.state
+        else:
+            direction = tilt(gt.direction, abs(float(rng.normal(0.0, n.direction_rad))), rng)
+            grasp = gt.grasp_point + outward + rng.normal(0.0, n.grasp_m, size=3)
+            shifted = gt.pivot + rng.normal(0.0, n.pivot_m, size=3)
+            state = gt.state + float(rng.normal(0.0, n.state))
+        pivot = canonical_pivot(direction, shifted, grasp)
         return JointAxisEstimate(gt.joint_type, direction, pivot, state, grasp, confidence=1.0)
 
 

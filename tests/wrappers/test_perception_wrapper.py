@@ -81,6 +81,36 @@ def test_noisy_oracle_noise_has_the_configured_magnitude() -> None:
     np.testing.assert_allclose([e.grasp_point for e in est], np.tile(gt.grasp_point, (3000, 1)))
 
 
+def test_noisy_oracle_fixed_offset_has_exact_sizes_held_for_the_episode() -> None:
+    from perception.metrics import line_distance
+
+    info = {"target_joint": 0, "joint_type": np.array([0]), "joint_axis": np.array([[0.0, 0.0, 1.0]]),
+            "joint_pivot": np.array([[0.1, 0.2, 0.0]]), "joint_state": np.array([0.3]),
+            "grasp_point": np.array([0.4, 0.2, 0.3])}
+    gt = ground_truth_estimate(info)
+    tilted = NoisyOracleSource(NoiseConfig(model="fixed_offset", direction_rad=0.2, pivot_m=0.0, state=0.1,
+                                           grasp_m=0.03), seed=4)
+    first = [tilted.estimate(None, info) for _ in range(5)]
+    for e in first:  # the same error at every estimate of the episode
+        np.testing.assert_allclose(e.direction, first[0].direction, atol=1e-12)
+        np.testing.assert_allclose(e.grasp_point, first[0].grasp_point, atol=1e-12)
+    assert np.arccos(np.clip(first[0].direction @ gt.direction, -1, 1)) == pytest.approx(0.2, abs=1e-9)
+    assert abs(first[0].state - 0.3) == pytest.approx(0.1, abs=1e-12)
+    assert np.linalg.norm(first[0].grasp_point - gt.grasp_point) == pytest.approx(0.03, abs=1e-12)
+    tilted.reset()  # a new episode draws a new tilt direction of the same size
+    again = tilted.estimate(None, info)
+    assert np.linalg.norm(again.direction - first[0].direction) > 1e-3
+    assert np.arccos(np.clip(again.direction @ gt.direction, -1, 1)) == pytest.approx(0.2, abs=1e-9)
+    # a pivot offset alone moves the line parallel to itself, exactly pivot_m off the true one
+    shifted = NoisyOracleSource(NoiseConfig(model="fixed_offset", direction_rad=0.0, pivot_m=0.04, state=0.0,
+                                            grasp_m=0.0), seed=1).estimate(None, info)
+    np.testing.assert_allclose(shifted.direction, gt.direction, atol=1e-12)
+    off = line_distance(shifted.direction, shifted.pivot, gt.direction, gt.pivot)
+    assert off == pytest.approx(0.04, abs=1e-9)
+    with pytest.raises(ConfigError, match="model"):
+        from_dict(NoiseConfig, {"model": "uniform"})
+
+
 def test_noisy_oracle_grasp_outward_bias_moves_the_grasp_point_away_from_the_joint() -> None:
     # hinge along z through (0.1, 0.2): the grasp point (0.4, 0.2, 0.3) lies 0.3 m out along +x
     info = {"target_joint": 0, "joint_type": np.array([0]), "joint_axis": np.array([[0.0, 0.0, 1.0]]),
