@@ -57,5 +57,14 @@ def run(args: argparse.Namespace) -> int:
         "epochs": cfg.epochs, "best_val_loss": result.best_val_loss,
         "voting_window": list(result.voting_window), "best_path": str(result.best_path),
         "log": str(result.log_path), "init_from": args.init_from,
+        "epoch_seconds": epoch_seconds(result.log_path),
     })
     return 0
+
+
+def epoch_seconds(log_path: str | Path) -> list[float]:
+    """Wall seconds of each epoch in a run's ``log.csv`` (resumed epochs included), in epoch order."""
+    import csv
+
+    with open(log_path, newline="") as fh:
+        return [float(row["seconds"]) for row in csv.DictReader(fh)]

@@ -6,6 +6,7 @@ import csv
 
 import pytest
 
+from capt_env.commands.train import epoch_seconds
 from perception.checkpoint import load_checkpoint
 from perception.config import CaptConfig, TrainConfig
 from perception.data import write_dataset
@@ -38,6 +39,8 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     rows = list(csv.DictReader(open(resumed.log_path)))
     assert [r["epoch"] for r in rows] == ["0", "1", "2"]
     assert float(rows[0]["train_total"]) > 0 and float(rows[0]["val_total"]) > 0
+    seconds = epoch_seconds(resumed.log_path)  # what `capt train --json` reports, resumed epochs too
+    assert len(seconds) == 3 and all(s > 0 for s in seconds)
     assert load_checkpoint(resumed.last_path).extra["epoch"] == 2
 
     # Same seed, uninterrupted run: identical weights to the interrupted-then-resumed one.
