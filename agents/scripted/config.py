@@ -119,6 +119,16 @@ class ScriptedOpenerConfig:
     this pull (the swept angle and the arc the hand follows; the first accepted fit is kept, as a hand
     slipping off the handle later leaves the arc). A pivot a few cm off the hinge of a 20 cm door reads
     the swept angle 0.4 rad too large, and the hand lets go short of open.
+    With ``motion_axis`` (off by default), the axis is also measured by how the part moved: the
+    estimated grasp points seen while the fingers held the part (every pull of the episode) are fitted
+    with a line (prismatic) or a circle in a plane (revolute: the plane's normal is the axis, the
+    circle's centre its pivot; :func:`agents.scripted.motion_axis.fit_motion_axis`) once they spread
+    ``motion_axis_min_travel`` m and, revolute, sweep ``motion_axis_min_angle`` rad; a fit within
+    ``motion_axis_max_rms`` m of the points, whose points spread off the line or plane at most
+    ``motion_axis_max_ratio`` of their spread along it, and within ``motion_axis_max_turn`` rad of
+    the estimated direction replaces the estimated axis for the rest of the episode (the pull starts
+    over from where the hand is). An axis a few degrees off makes the commanded arc or line leave
+    the part's own, and the fingers slide off it (``capt noise-sweep``).
     With ``rehearse_fingers`` (and the arm's joint angles in the observation), the two finger orders of
     a grasp (not a lid's) are first rehearsed on the Panda's kinematic model
     (:mod:`agents.scripted.grasp_rehearsal`): turn, pre-grasp, approach and the pull to its target,
@@ -197,6 +207,12 @@ class ScriptedOpenerConfig:
     arc_fit_min_angle: float = 0.3
     arc_fit_max_rms: float = 0.004
     arc_fit_max_shift: float = 0.15
+    motion_axis: bool = False
+    motion_axis_min_travel: float = 0.03
+    motion_axis_min_angle: float = 0.4
+    motion_axis_max_rms: float = 0.004
+    motion_axis_max_turn: float = 0.6
+    motion_axis_max_ratio: float = 0.1
     rehearse_fingers: bool = True
     rehearse_margin: float = 0.2
     rehearse_track_m: float = 0.02
@@ -206,7 +222,9 @@ class ScriptedOpenerConfig:
                     "revolute_lead", "lid_lift_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
                     "revolute_target", "prismatic_target", "lid_revolute_target",
                     "slip_distance", "hold_gap", "limit_min_speed_m", "arc_fit_min_chord",
-                    "arc_fit_min_angle", "arc_fit_max_rms", "arc_fit_max_shift", "settle_progress"):
+                    "arc_fit_min_angle", "arc_fit_max_rms", "arc_fit_max_shift", "settle_progress",
+                    "motion_axis_min_travel", "motion_axis_min_angle", "motion_axis_max_rms",
+                    "motion_axis_max_turn", "motion_axis_max_ratio"):
             require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         require(0.0 < self.rehearse_margin <= 1.0,
                 f"rehearse_margin must be in (0, 1] (a share of the pull path), got {self.rehearse_margin}")

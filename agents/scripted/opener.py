@@ -54,6 +54,7 @@ out of the door's sweep and waits while it falls, then is done or grasps again (
 from __future__ import annotations
 
 import enum
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -79,8 +80,9 @@ from agents.scripted.grasp_pose import (
     part_kind,
 )
 from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
+from agents.scripted.motion_axis import MotionAxis, fit_motion_axis
 from agents.scripted.panda_kinematics import PANDA_LOWER, PANDA_UPPER, pose_matrix
-from capt_env.wrappers.estimate import JointAxisEstimate, unit
+from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, unit
 from capt_env.wrappers.joint_observation import decode_observation
 
 GRIPPER_OPEN = 1.0
@@ -163,6 +165,9 @@ class ScriptedOpener:
         self._pulled: list[np.ndarray] = []  # TCP positions of this pull, every step
         self._held: list[np.ndarray] = []  # those while the fingers held the part
         self._hinge_fit: np.ndarray | None = None  # the hinge pivot fitted to the held path
+        self._part_path: list[np.ndarray] = []  # estimated grasp points while held, every pull
+        self._motion: MotionAxis | None = None  # the axis fitted to them (motion_axis), kept
+        self._motion_type = ""  # the joint type it was fitted for
         self._slip_count = 0
         self._retreat_from: np.ndarray | None = None
         self._grasp_again = False
@@ -256,6 +261,8 @@ class ScriptedOpener:
         p = np.asarray(tcp_pose[:3], dtype=np.float64)
         r = quat_to_matrix(tcp_pose[3:7])
         self.phase_steps += 1
+        if self._motion is not None and est.joint_type == self._motion_type:
+            est = self._with_motion_axis(est)  # every phase (re-grasps too) goes by the measured axis
 
         if self.phase in (Phase.PREGRASP, Phase.APPROACH):
             if self._falling_on_its_own(est):
@@ -459,6 +466,50 @@ class ScriptedOpener:
         self._hinge_fit = fit[0]
         return fit[0]
 
+    def _motion_axis(self, est: JointAxisEstimate, u: np.ndarray, p: np.ndarray, r: np.ndarray,
+                     finger_gap: float | None, revolute: bool) -> np.ndarray:
+        """The axis direction to pull along (``motion_axis``): the one fitted to the path of the
+        estimated grasp point while held (:func:`fit_motion_axis`), once it fits, else ``u``. The
+        first accepted fit is kept for the episode (later pulls too) and starts this pull over from
+        where the hand is, so the arc or line it follows does not jump."""
+        cfg = self.cfg
+        holding = finger_gap is not None and finger_gap >= cfg.hold_gap
+        gp = np.asarray(est.grasp_point, dtype=np.float64)
+        if holding and (not self._part_path or np.linalg.norm(gp - self._part_path[-1]) > 1e-3):
+            self._part_path.append(gp.copy())  # a new estimate (they repeat between looks)
+        if self._motion is None and holding:
+            pivot = self._hinge_fit if self._hinge_fit is not None else est.pivot
+            fit = fit_motion_axis(np.asarray(self._part_path), u, pivot, revolute,
+                                  cfg.motion_axis_min_travel, cfg.motion_axis_min_angle,
+                                  cfg.motion_axis_max_rms, cfg.motion_axis_max_turn,
+                                  cfg.motion_axis_max_ratio)
+            if fit is not None:
+                assert self._grasp_p is not None
+                if revolute:
+                    self._grasp_state += swept_angle(u, pivot, self._grasp_p, p)
+                else:
+                    self._grasp_state += float((p - self._grasp_p) @ u)
+                self._grasp_p, self._grasp_r, self._grasp_u = p.copy(), r.copy(), fit.direction
+                self._pulled, self._held, self._hinge_fit = [p.copy()], [p.copy()], None
+                self._motion, self._motion_type = fit, est.joint_type
+        if self._motion is None:
+            return u
+        direction = self._motion.direction
+        return direction if float(direction @ u) >= 0.0 else -direction
+
+    def _with_motion_axis(self, est: JointAxisEstimate) -> JointAxisEstimate:
+        """``est`` with the axis fitted to the part's motion (signed like ``est``'s direction; a
+        revolute pivot moved to the point of the fitted line closest to the grasp point)."""
+        assert self._motion is not None
+        direction = self._motion.direction
+        if float(direction @ est.direction) < 0.0:
+            direction = -direction
+        pivot = est.pivot
+        if est.joint_type == "revolute":
+            grasp = np.asarray(est.grasp_point, dtype=np.float64)
+            pivot = canonical_pivot(direction, self._motion.pivot, grasp)
+        return replace(est, direction=direction, pivot=pivot)
+
     def _falling_on_its_own(self, est: JointAxisEstimate) -> bool:
         """Whether, before its grasp, a part that :func:`falls_open` is seen falling open: at least
         ``settle_above`` rad open and risen by ``settle_progress`` rad over the last ``settle_window``
@@ -522,9 +573,14 @@ class ScriptedOpener:
             # the part opens the way it did when the pull began: a re-estimate that flips the axis
             # (the sign is what a single view gets wrong most) would read the opening as closing
             u = -u
+        if cfg.motion_axis:
+            u = self._motion_axis(est, u, p, r, finger_gap, revolute)
         # while the hand holds the part, its own travel along the estimated arc or line measures the
         # part's state every step; the perceived state is noisier and only as fresh as the last estimate
-        pivot = self._hinge_pivot(u, est.pivot, p, finger_gap) if revolute else est.pivot
+        if self._motion is not None:
+            pivot = self._motion.pivot
+        else:
+            pivot = self._hinge_pivot(u, est.pivot, p, finger_gap) if revolute else est.pivot
         if revolute:
             state = self._grasp_state + swept_angle(u, pivot, self._grasp_p, p)
         else:
