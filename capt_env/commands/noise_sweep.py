@@ -17,13 +17,13 @@ from typing import Any
 from capt_env.commands.noise_overrides import add_noise_argument, check_noise, noise_overrides, resolved_noise
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 
-# swept parameter -> (NoiseConfig field, factor from the parameter's unit to the field's, unit)
-PARAMETERS: dict[str, tuple[str, float, str]] = {
-    "direction_deg": ("direction_rad", math.pi / 180.0, "deg"),
-    "pivot_m": ("pivot_m", 1.0, "m"),
-    "state": ("state", 1.0, "rad or m"),
-    "grasp_m": ("grasp_m", 1.0, "m"),
-    "grasp_outward_m": ("grasp_outward_m", 1.0, "m"),
+# swept parameter -> (NoiseConfig field, factor from the parameter's unit to the field's, unit, label)
+PARAMETERS: dict[str, tuple[str, float, str, str]] = {
+    "direction_deg": ("direction_rad", math.pi / 180.0, "deg", "axis direction error"),
+    "pivot_m": ("pivot_m", 1.0, "m", "axis line offset"),
+    "state": ("state", 1.0, "rad or m", "state error"),
+    "grasp_m": ("grasp_m", 1.0, "m", "grasp point error"),
+    "grasp_outward_m": ("grasp_outward_m", 1.0, "m", "grasp point outward bias"),
 }
 
 
@@ -61,11 +61,22 @@ def sweep_noise(parameter: str, value: float, model: str, base: dict[str, Any]) 
     ``--noise`` overrides), then the swept field set to ``value`` converted from the parameter's unit."""
     if parameter not in PARAMETERS:
         raise ValueError(f"unknown parameter {parameter!r}; choose from {sorted(PARAMETERS)}")
-    field, factor, _ = PARAMETERS[parameter]
+    field, factor = PARAMETERS[parameter][:2]
     if field in base:
         raise SystemExit(f"--noise sets {field}, which --parameter {parameter} sweeps")
     zero = {spec[0]: 0.0 for spec in PARAMETERS.values()}
     return {**zero, **base, "model": model, field: value * factor}
+
+
+def sweep_table(parameter: str, rows: list[dict[str, Any]]) -> str:
+    """The Markdown table of a sweep's result rows (one per category and value)."""
+    from capt_env.commands.rollout import success_cells
+
+    _, _, unit, label = PARAMETERS[parameter]
+    lines = [f"| category | {label} ({unit}) | success | 95% interval | mean opened | mean steps | "
+             "episodes |", "| --- | --- | --- | --- | --- | --- | --- |"]
+    lines += [f"| {r['category']} | {r['value']:g} | {success_cells(r)} |" for r in rows]
+    return "\n".join(lines)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -74,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
     from capt_env.commands.episode_log import EpisodeLog
     from capt_env.commands.episode_runner import EpisodeJob, play_episodes
     from capt_env.commands.json_output import write_json
-    from capt_env.commands.rollout import opener_config, ppo_model, success_cells, success_row
+    from capt_env.commands.rollout import opener_config, ppo_model, success_row
     from perception.yaml_config import to_dict
 
     if args.episodes < 1:
@@ -95,8 +106,6 @@ def run(args: argparse.Namespace) -> int:
     task = task_overrides(args.task)
     opener = opener_config(args.opener) if args.policy == "scripted" else None
     seeds = list(range(args.first_seed, args.first_seed + args.episodes))
-    lines = [f"| category | {args.parameter} ({unit}) | success | 95% interval | mean opened | mean steps | "
-             "episodes |", "| --- | --- | --- | --- | --- | --- | --- |"]
     rows = []
     for category in args.categories:
         model = ppo_model(args, category)
@@ -110,8 +119,7 @@ def run(args: argparse.Namespace) -> int:
                    "parameter": args.parameter, "value": value, "noise": resolved_noise(noise),
                    **success_row(episodes)}
             rows.append(row)
-            lines.append(f"| {category} | {value:g} | {success_cells(row)} |")
-    table = "\n".join(lines)
+    table = sweep_table(args.parameter, rows)
     print(table)
     if args.markdown:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
