@@ -66,3 +66,13 @@ def test_noise_sweep_plays_every_value_on_the_same_seeds(tmp_path: Path) -> None
     assert "| cabinet_door | 30 |" in table.read_text()
     with pytest.raises(SystemExit, match="values"):
         main(["noise-sweep", "--parameter", "pivot_m", "--values", "-0.01"])
+
+
+def test_rollout_records_the_noise_it_ran_with(tmp_path: Path) -> None:
+    out = tmp_path / "rollout.json"
+    assert main(["rollout", "--categories", "laptop", "--perception", "noisy_oracle", "--noise",
+                 "model=fixed_offset", "direction_rad=0.1", "--episodes", "1", "--max-steps", "3",
+                 "--json", str(out)]) == 0
+    noise = json.loads(out.read_text())["noise"]
+    assert noise["model"] == "fixed_offset" and noise["direction_rad"] == 0.1
+    assert noise["pivot_m"] == 0.01  # unset fields are the defaults, written out
