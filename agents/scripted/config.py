@@ -123,7 +123,8 @@ class ScriptedOpenerConfig:
     estimated grasp points seen while the fingers held the part (every pull of the episode) are fitted
     with a line (prismatic) or a circle in a plane (revolute: the plane's normal is the axis, the
     circle's centre its pivot; :func:`agents.scripted.motion_axis.fit_motion_axis`) once they spread
-    ``motion_axis_min_travel`` m and, revolute, sweep ``motion_axis_min_angle`` rad; a fit within
+    ``motion_axis_min_travel`` m and, revolute, sweep ``motion_axis_min_angle`` rad and number
+    ``motion_axis_hinge_points`` (a line needs 3; a plane and circle through 4 fit anything); a fit within
     ``motion_axis_max_rms`` m of the points, whose points spread off the line or plane at most
     ``motion_axis_max_ratio`` of their spread along it, and within ``motion_axis_max_turn`` rad of
     the estimated direction replaces the estimated axis for the rest of the episode (the pull starts
@@ -213,6 +214,7 @@ class ScriptedOpenerConfig:
     motion_axis_max_rms: float = 0.004
     motion_axis_max_turn: float = 0.6
     motion_axis_max_ratio: float = 0.1
+    motion_axis_hinge_points: int = 6
     rehearse_fingers: bool = True
     rehearse_margin: float = 0.2
     rehearse_track_m: float = 0.02
@@ -235,6 +237,8 @@ class ScriptedOpenerConfig:
                 f"rechoose_grasp_m must be >= 0 m (0: never), got {self.rechoose_grasp_m}")
         require(self.rechoose_steps >= 0, f"rechoose_steps must be >= 0, got {self.rechoose_steps}")
         require(self.rechoose_looks >= 1, f"rechoose_looks must be >= 1, got {self.rechoose_looks}")
+        require(self.motion_axis_hinge_points >= 4,
+                f"motion_axis_hinge_points must be >= 4, got {self.motion_axis_hinge_points}")
         require(self.rotate_first_steps >= 0,
                 f"rotate_first_steps must be >= 0 (0: never), got {self.rotate_first_steps}")
         for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",

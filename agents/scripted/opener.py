@@ -482,7 +482,8 @@ class ScriptedOpener:
             fit = fit_motion_axis(np.asarray(self._part_path), u, pivot, revolute,
                                   cfg.motion_axis_min_travel, cfg.motion_axis_min_angle,
                                   cfg.motion_axis_max_rms, cfg.motion_axis_max_turn,
-                                  cfg.motion_axis_max_ratio)
+                                  cfg.motion_axis_max_ratio,
+                                  cfg.motion_axis_hinge_points if revolute else 3)
             if fit is not None:
                 assert self._grasp_p is not None
                 if revolute:

@@ -47,6 +47,8 @@ def test_a_doors_path_gives_its_hinge_line() -> None:
     assert fit is not None and np.degrees(np.arccos(fit.direction @ axis)) < 0.01
     off = fit.pivot - hinge
     assert np.linalg.norm(off - (off @ axis) * axis) < 1e-6  # on the true hinge line
+    # fewer points than asked for are refused (the opener asks a hinge for 6: 4 fit anything)
+    assert fit_motion_axis(path[:5], estimate, hinge, revolute=True, **FIT, min_points=6) is None
     # an arc of 0.2 rad does not sweep min_angle; one 20 deg farther than max_turn is refused
     assert fit_motion_axis(path[:3], estimate, hinge, revolute=True, **FIT) is None
     assert fit_motion_axis(path, _tilted(axis, 0.8), hinge, revolute=True, **FIT) is None
