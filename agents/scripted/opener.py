@@ -466,6 +466,14 @@ class ScriptedOpener:
         self._hinge_fit = fit[0]
         return fit[0]
 
+    def _hand_state(self, u: np.ndarray, pivot: np.ndarray, p: np.ndarray, revolute: bool) -> float:
+        """The part's state (rad or m) by the hand's own measure: the state at the grasp plus the
+        TCP's travel from the grasp position to ``p`` about (revolute) or along unit axis ``u``."""
+        assert self._grasp_p is not None
+        if revolute:
+            return self._grasp_state + swept_angle(u, pivot, self._grasp_p, p)
+        return self._grasp_state + float((p - self._grasp_p) @ u)
+
     def _motion_axis(self, est: JointAxisEstimate, u: np.ndarray, p: np.ndarray, r: np.ndarray,
                      finger_gap: float | None, revolute: bool) -> np.ndarray:
         """The axis direction to pull along (``motion_axis``): the one fitted to the path of the
@@ -485,11 +493,7 @@ class ScriptedOpener:
                                   cfg.motion_axis_max_ratio,
                                   cfg.motion_axis_hinge_points if revolute else 3)
             if fit is not None:
-                assert self._grasp_p is not None
-                if revolute:
-                    self._grasp_state += swept_angle(u, pivot, self._grasp_p, p)
-                else:
-                    self._grasp_state += float((p - self._grasp_p) @ u)
+                self._grasp_state = self._hand_state(u, pivot, p, revolute)
                 self._grasp_p, self._grasp_r, self._grasp_u = p.copy(), r.copy(), fit.direction
                 self._pulled, self._held, self._hinge_fit = [p.copy()], [p.copy()], None
                 self._motion, self._motion_type = fit, est.joint_type
@@ -582,10 +586,7 @@ class ScriptedOpener:
             pivot = self._motion.pivot
         else:
             pivot = self._hinge_pivot(u, est.pivot, p, finger_gap) if revolute else est.pivot
-        if revolute:
-            state = self._grasp_state + swept_angle(u, pivot, self._grasp_p, p)
-        else:
-            state = self._grasp_state + float((p - self._grasp_p) @ u)
+        state = self._hand_state(u, pivot, p, revolute)
         self._history.append(state)
         self._pulled.append(p.copy())
         # a drawer runs freely up to its end stop, where the hand brakes before the handle slides out
