@@ -7,6 +7,12 @@ joints and in metres over prismatic ones (never averaged together), each first a
 category's joints. A joint without a position error is prismatic (``capt evaluate`` reports none for
 them). A mean over no value (e.g. position when every category is prismatic) is "-".
 
+Then, for every method beside the reference (``--reference``, default ``capt``), the paired gap
+reference minus method on each category and on the mean, with a 95% bootstrap interval over the test
+clouds (``perception/paired_comparison.py``; ``--draws``, ``--seed``): negative means the reference
+has the lower error, and an interval that excludes 0 means the gap is more than the luck of which
+clouds are in the test split (it does not measure training noise).
+
     .venv/bin/python scripts/compare_variants.py benchmarks/perception_laptop.json \
         benchmarks/perception_oven.json --markdown benchmarks/variants_mean.md \
         --json benchmarks/variants_mean.json
@@ -18,6 +24,8 @@ import argparse
 import json
 import statistics
 from pathlib import Path
+
+from perception.paired_comparison import PairedDifference, paired_differences
 
 METRICS = (("dir_med", "direction (deg)"), ("pos_aed", "position (normalised)"),
            ("state_deg", "state, revolute (deg)"), ("state_m", "state, prismatic (m)"))
@@ -39,12 +47,17 @@ def category_errors(s: dict) -> dict[str, float | None]:
             "state_m": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if not r])}
 
 
-def compare(paths: list[Path]) -> dict:
-    """{"methods": [...], "categories": {cat: {method: {metric: value}}}, "mean": {method: {...}}}."""
+def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed: int = 0) -> dict:
+    """{"methods": [...], "categories": {cat: {method: {metric: value}}}, "mean": {method: {...}},
+    "paired": {method: {cat or "mean": {metric: {difference, low, high, reference_lower_share}}}}}.
+    ``paired`` is empty when ``draws`` is 0, when the files hold no per-sample results, or when the
+    reference method is not in them."""
     per_cat: dict[str, dict[str, dict[str, float | None]]] = {}
+    samples: list[dict] = []
     for path in paths:
-        summary = json.loads(path.read_text())["summary"]
-        for method, cats in summary.items():
+        run = json.loads(path.read_text())
+        samples.extend(run.get("samples", []))
+        for method, cats in run["summary"].items():
             for cat, s in cats.items():
                 per_cat.setdefault(cat, {})[method] = category_errors(s)
     methods = sorted(set.intersection(*(set(v) for v in per_cat.values())))
@@ -52,7 +65,17 @@ def compare(paths: list[Path]) -> dict:
         raise SystemExit("no method was evaluated on every category")
     mean = {m: {k: joint_mean([per_cat[c][m][k] for c in per_cat]) for k, _ in METRICS}
             for m in methods}
-    return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths]}
+    paired: dict = {}
+    if draws > 0 and any(x["method"] == reference for x in samples):
+        paired = {m: {c: {k: _as_dict(d) for k, d in by_metric.items()} for c, by_metric in rows.items()}
+                  for m, rows in paired_differences(samples, reference, draws, seed).items()}
+    return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths],
+            "reference": reference, "draws": draws, "seed": seed, "paired": paired}
+
+
+def _as_dict(d: PairedDifference | None) -> dict | None:
+    return None if d is None else {"difference": d.difference, "low": d.low, "high": d.high,
+                                   "reference_lower_share": d.reference_lower_share}
 
 
 def markdown(result: dict) -> str:
@@ -63,7 +86,22 @@ def markdown(result: dict) -> str:
         for m in result["methods"]:
             cells = ["-" if by_method[m][k] is None else f"{by_method[m][k]:.4g}" for k, _ in METRICS]
             lines.append(f"| {cat} | {m} | " + " | ".join(cells) + " |")
+    if result.get("paired"):
+        ref = result["reference"]
+        lines += ["", f"{ref} minus each method, with a 95% paired bootstrap interval over the test clouds "
+                  f"({result['draws']} draws, seed {result['seed']}; negative: {ref} has the lower "
+                  "error):", "",
+                  "| category | method | " + " | ".join(label for _, label in METRICS) + " |",
+                  "|" + " --- |" * (len(METRICS) + 2)]
+        for other, rows in result["paired"].items():
+            for cat in [*sorted(c for c in rows if c != "mean"), "mean"]:
+                cells = ["-" if rows[cat][k] is None else _gap(rows[cat][k]) for k, _ in METRICS]
+                lines.append(f"| {cat} | {ref} - {other} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+def _gap(d: dict) -> str:
+    return f"{d['difference']:+.3g} [{d['low']:+.3g}, {d['high']:+.3g}]"
 
 
 def main() -> None:
@@ -71,8 +109,14 @@ def main() -> None:
     parser.add_argument("inputs", nargs="+", type=Path, help="capt evaluate --json files")
     parser.add_argument("--markdown", type=Path, default=None)
     parser.add_argument("--json", type=Path, default=None)
+    parser.add_argument("--reference", default="capt",
+                        help="method whose gaps to the others are bootstrapped")
+    parser.add_argument("--draws", type=int, default=2000, help="bootstrap draws (0: no paired gaps)")
+    parser.add_argument("--seed", type=int, default=0, help="bootstrap seed")
     args = parser.parse_args()
-    result = compare(args.inputs)
+    if args.draws < 0:
+        parser.error(f"--draws must be >= 0, got {args.draws}")
+    result = compare(args.inputs, args.reference, args.draws, args.seed)
     table = markdown(result)
     print(table, end="")
     if args.markdown:

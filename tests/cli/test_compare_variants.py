@@ -57,3 +57,29 @@ def test_a_category_with_both_joint_types_and_an_all_prismatic_set(tmp_path):
         "capt": {"dir_med": [6.0], "pos_aed": [None], "state_med": [0.03]}})
     mean = cv.compare([drawers])["mean"]["capt"]
     assert mean["pos_aed"] is None and mean["state_deg"] is None and mean["state_m"] == pytest.approx(0.03)
+
+
+def test_paired_gaps_from_per_sample_results(tmp_path):
+    """With the per-sample results of `capt evaluate --json`, the reference's gap to each method comes
+    with a bootstrap interval, per category and over the mean; without them there is no such table."""
+    cv = _load()
+    samples = []
+    for i in range(30):
+        for method, extra in (("capt", 0.0), ("capt_plain", 2.0)):
+            samples.append({"category": "laptop", "method": method, "joints": [
+                {"joint_index": 0, "joint_type": "revolute", "direction_error_deg": i + extra,
+                 "position_error": 0.01, "state_error": 3.0}]})
+    run = {"summary": {"capt": {"laptop": {"dir_med": [14.5], "pos_aed": [0.01], "state_med": [3.0]}},
+                       "capt_plain": {"laptop": {"dir_med": [16.5], "pos_aed": [0.01], "state_med": [3.0]}}},
+           "samples": samples}
+    path = tmp_path / "laptop.json"
+    path.write_text(json.dumps(run))
+    result = cv.compare([path], draws=200, seed=1)
+    gap = result["paired"]["capt_plain"]["mean"]["dir_med"]
+    assert gap["difference"] == pytest.approx(-2.0) and gap["high"] == pytest.approx(-2.0)
+    assert result["paired"]["capt_plain"]["laptop"]["state_m"] is None
+    table = cv.markdown(result)
+    assert "| mean | capt - capt_plain | -2 [-2, -2] | +0 [+0, +0] | +0 [+0, +0] | - |" in table
+    assert cv.compare([path], draws=0)["paired"] == {}
+    summary_only = _write(tmp_path / "s.json", "laptop", {m: v["laptop"] for m, v in run["summary"].items()})
+    assert cv.compare([summary_only])["paired"] == {}

@@ -1,0 +1,126 @@
+"""Paired bootstrap of the gap between two methods' mean errors on the same test clouds (Table I
+comparisons: is CAPT's lower mean error more than the luck of which clouds are in the test split?).
+
+``capt evaluate`` scores every checkpoint on the same clouds of a split in the same order, so the
+i-th sample of one method and the i-th sample of another are one cloud. A bootstrap draw resamples
+cloud indices with replacement, the same indices for both methods, and recomputes each method's
+table value exactly as the table does: per joint slot the mean over the clouds that have that joint,
+then the mean over joint slots. The interval says how much the gap moves with the test clouds; it
+says nothing of training noise (another training seed can order two close methods the other way).
+
+Metrics (per-sample fields of ``capt evaluate --json``):
+
+- ``dir_med``: direction error, degrees, every joint;
+- ``pos_aed``: axis-line distance in the normalised object frame, revolute joints only;
+- ``state_deg``: state error of revolute joints, degrees; ``state_m``: of prismatic joints, metres.
+
+A difference is reference minus other: negative means the reference has the lower error.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+METRICS: tuple[str, ...] = ("dir_med", "pos_aed", "state_deg", "state_m")
+_FIELDS = {"dir_med": ("direction_error_deg", None), "pos_aed": ("position_error", "revolute"),
+           "state_deg": ("state_error", "revolute"), "state_m": ("state_error", "prismatic")}
+
+
+@dataclass(frozen=True)
+class PairedDifference:
+    """Reference minus other of one table value: the point difference (on all clouds), the 95%
+    percentile bootstrap interval [low, high], and the share of draws in which the reference is lower."""
+
+    difference: float
+    low: float
+    high: float
+    reference_lower_share: float
+
+
+def error_matrix(samples: Sequence[Mapping], metric: str) -> np.ndarray:
+    """(clouds, joint slots) errors of one method on one category, NaN where a cloud has no such joint
+    (or the joint is of the other type for ``pos_aed``/``state_*``). ``samples`` are the per-sample
+    dicts of ``capt evaluate --json`` for one method and one category, in evaluation order."""
+    if metric not in _FIELDS:
+        raise ValueError(f"unknown metric {metric!r}; expected one of {METRICS}")
+    field, joint_type = _FIELDS[metric]
+    slots = 1 + max((j["joint_index"] for s in samples for j in s["joints"]), default=-1)
+    out = np.full((len(samples), max(slots, 1)), np.nan)
+    for i, s in enumerate(samples):
+        for j in s["joints"]:
+            value = j.get(field)
+            if value is None or (joint_type is not None and j["joint_type"] != joint_type):
+                continue
+            out[i, j["joint_index"]] = float(value)
+    return out
+
+
+def table_value(errors: np.ndarray) -> np.ndarray:
+    """The table's value of ``errors`` (..., clouds, joints): per joint the mean over clouds that have
+    it, then the mean over joints that any cloud has; NaN when none has a value."""
+    present = ~np.isnan(errors)
+    count = present.sum(axis=-2)
+    per_joint = np.where(present, errors, 0.0).sum(axis=-2) / np.maximum(count, 1)
+    has = count > 0
+    n = has.sum(axis=-1)
+    with np.errstate(invalid="ignore"):
+        return np.where(n > 0, np.where(has, per_joint, 0.0).sum(axis=-1) / np.maximum(n, 1), np.nan)
+
+
+def bootstrap_difference(pairs: Mapping[str, tuple[np.ndarray, np.ndarray]], draws: int = 2000,
+                         seed: int = 0) -> PairedDifference | None:
+    """Reference minus other of the mean over categories of the table value. ``pairs`` maps each
+    category to (reference, other) error matrices of the same shape (see :func:`error_matrix`); each
+    draw resamples every category's clouds independently. Categories where the metric has no value
+    (e.g. position of a drawer) are left out, as the table's mean leaves them out; None if none has."""
+    if draws < 1:
+        raise ValueError(f"draws must be >= 1, got {draws}")
+    rng = np.random.default_rng(seed)
+    point, boot = [], []
+    for category, (ref, other) in sorted(pairs.items()):
+        if ref.shape != other.shape:
+            raise ValueError(f"{category}: the two methods were scored on different clouds "
+                             f"({ref.shape[0]} vs {other.shape[0]} samples, {ref.shape[1]} vs "
+                             f"{other.shape[1]} joint slots); compare checkpoints from one "
+                             "`capt evaluate` run")
+        diff = float(table_value(ref) - table_value(other))
+        if np.isnan(diff):
+            continue
+        idx = rng.integers(0, ref.shape[0], size=(draws, ref.shape[0]))
+        point.append(diff)
+        boot.append(table_value(ref[idx]) - table_value(other[idx]))
+    if not point:
+        return None
+    dist = np.mean(boot, axis=0)
+    low, high = np.percentile(dist, [2.5, 97.5])
+    return PairedDifference(float(np.mean(point)), float(low), float(high), float(np.mean(dist < 0.0)))
+
+
+def paired_differences(samples: Sequence[Mapping], reference: str, draws: int = 2000, seed: int = 0
+                       ) -> dict[str, dict[str, dict[str, PairedDifference | None]]]:
+    """``{other method: {category or "mean": {metric: PairedDifference or None}}}`` for every method
+    scored on every category beside ``reference``, from the per-sample dicts of one or more
+    ``capt evaluate --json`` files (each category from one run). Seeded: the same input gives the same
+    intervals."""
+    groups: dict[tuple[str, str], list[Mapping]] = {}
+    for s in samples:
+        groups.setdefault((s["category"], s["method"]), []).append(s)
+    categories = sorted({c for c, _ in groups})
+    if not any((c, reference) in groups for c in categories):
+        raise ValueError(f"no samples of the reference method {reference!r}")
+    others = sorted({m for _, m in groups if m != reference
+                     and all((c, m) in groups and (c, reference) in groups for c in categories)})
+    result: dict[str, dict[str, dict[str, PairedDifference | None]]] = {}
+    for other in others:
+        rows: dict[str, dict[str, PairedDifference | None]] = {c: {} for c in [*categories, "mean"]}
+        for metric in METRICS:
+            pairs = {c: (error_matrix(groups[(c, reference)], metric),
+                         error_matrix(groups[(c, other)], metric)) for c in categories}
+            for c in categories:
+                rows[c][metric] = bootstrap_difference({c: pairs[c]}, draws, seed)
+            rows["mean"][metric] = bootstrap_difference(pairs, draws, seed)
+        result[other] = rows
+    return result
