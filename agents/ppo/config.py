@@ -12,6 +12,8 @@ from capt_env.wrappers.config import PerceptionWrapperConfig
 from perception.yaml_config import from_dict, require
 
 ObsMode = Literal["state", "pointcloud"]
+VecEnvKind = Literal["processes", "maniskill"]
+SimBackend = Literal["auto", "physx_cpu", "physx_cuda"]
 
 
 @dataclass(frozen=True)
@@ -98,6 +100,15 @@ class PPOTrainConfig:
     opener instead of actions from scratch (:class:`ResidualConfig`). ``continue_after_success``:
     training episodes do not end at the task's success but run to ``max_episode_steps``
     (:class:`agents.ppo.train.ContinueAfterSuccess` says why).
+
+    ``vec_env``: ``processes`` (the above) or ``maniskill``: all ``n_envs`` sub-scenes in one batched
+    ManiSkill env (``CaptOpen*-ms-v0``) on ``sim_backend`` (``auto``: ``physx_cuda``, ManiSkill's GPU
+    simulation, when ``n_envs > 1``, else ``physx_cpu``, which holds one sub-scene), observed by
+    :class:`capt_env.wrappers.batched_oracle_observation.BatchedOracleObservation` and stepped by
+    :class:`agents.ppo.maniskill_vec_env.ManiSkillVecEnv`. It takes the ``oracle`` or
+    ``noisy_oracle`` source, ``obs_mode: state`` and no residual (the scripted opener runs per env
+    in numpy). Its sub-scenes share one object instance; every ``reconfigure_every_steps`` batch
+    steps (0: never) all episodes are cut and a new train-split instance is built.
     """
 
     category: str = "laptop"
@@ -114,6 +125,9 @@ class PPOTrainConfig:
     normalize_obs: bool = True
     residual: ResidualConfig = field(default_factory=ResidualConfig)
     continue_after_success: bool = True
+    vec_env: VecEnvKind = "processes"
+    sim_backend: SimBackend = "auto"
+    reconfigure_every_steps: int = 0
 
     def validate(self) -> None:
         require(self.category in CATEGORY_ENV_NAMES,
@@ -138,10 +152,30 @@ class PPOTrainConfig:
                 f"max_episode_steps must be in [1, {MAX_EPISODE_STEPS}], got {self.max_episode_steps}")
         for key in ("category", "object", "joint"):
             require(key not in self.task, f"task.{key}: the object is chosen by 'category', not task")
+        require(self.reconfigure_every_steps >= 0,
+                f"reconfigure_every_steps must be >= 0, got {self.reconfigure_every_steps}")
+        if self.vec_env == "maniskill":
+            require(not self.residual.enabled, "vec_env 'maniskill' takes no residual policy (the scripted "
+                    "opener runs per env in numpy): use vec_env 'processes'")
+            require(self.perception.source in ("oracle", "noisy_oracle"),
+                    f"vec_env 'maniskill' takes perception.source 'oracle' or 'noisy_oracle', got "
+                    f"{self.perception.source!r} (CAPT runs in the per-process envs)")
+            require(self.obs_mode == "state",
+                    f"vec_env 'maniskill' needs obs_mode: state, got {self.obs_mode!r}")
+            require(self.resolved_sim_backend() == "physx_cuda" or self.n_envs == 1,
+                    f"sim_backend 'physx_cpu' holds one sub-scene; n_envs is {self.n_envs} (use physx_cuda "
+                    f"on a GPU, or vec_env 'processes')")
         require(self.task.get("split", "train") == "train",
                 f"task.split must be 'train' for training (test instances are for evaluation), "
                 f"got {self.task.get('split')!r}")
         from_dict(TaskConfig, self.train_task() | {"category": self.category}, where="task")
+
+    def resolved_sim_backend(self) -> str:
+        """``sim_backend`` with ``auto`` resolved: ``physx_cuda`` for more than one env, else
+        ``physx_cpu``."""
+        if self.sim_backend != "auto":
+            return self.sim_backend
+        return "physx_cuda" if self.n_envs > 1 else "physx_cpu"
 
     def train_task(self) -> dict[str, Any]:
         """The task overrides for training envs, with the train split."""

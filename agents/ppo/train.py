@@ -13,10 +13,10 @@ Layout of ``out_dir``::
                                      events too, when tensorboard is installed)
     final.zip, vecnormalize.pkl      the last model and its observation normalisation
 
-Only CPU vector envs are built here (one process per env). On a CUDA machine ManiSkill's GPU
-simulation (the ``CaptOpen*-ms-v0`` ids with ``sim_backend="physx_cuda"`` and ``num_envs`` in the
-hundreds, plus ``ManiSkillVectorEnv``) would give far more steps per second, but the perception
-wrapper works on single numpy envs, so that path is not implemented.
+With ``vec_env: processes`` the envs are CPU envs, one process each (:func:`make_vec_env`). With
+``vec_env: maniskill`` they are the sub-scenes of one batched ManiSkill env, on ManiSkill's GPU
+simulation when ``n_envs > 1`` (:func:`make_maniskill_vec_env`; ground-truth sources only). That
+path is tested on the CPU with one sub-scene; it has not run on a GPU here.
 """
 
 from __future__ import annotations
@@ -100,9 +100,35 @@ def make_train_env(config: PPOTrainConfig, rank: int) -> gym.Env:
     return Monitor(env, info_keywords=("success",))
 
 
+def make_maniskill_vec_env(config: PPOTrainConfig) -> VecEnv:
+    """``n_envs`` sub-scenes of one batched ManiSkill env of the train split behind
+    ``BatchedOracleObservation`` and ``ManiSkillVecEnv`` (``vec_env: maniskill``); not yet
+    normalised or seeded. Raises ConfigError when the simulation backend needs CUDA and none is here."""
+    import torch
+
+    import capt_env  # noqa: F401 - registers the ids
+    from agents.ppo.maniskill_vec_env import ManiSkillVecEnv
+    from capt_env.registration import env_id
+    from capt_env.wrappers.batched_oracle_observation import BatchedOracleObservation
+
+    backend = config.resolved_sim_backend()
+    if backend == "physx_cuda" and not torch.cuda.is_available():
+        raise ConfigError(f"vec_env 'maniskill' with {config.n_envs} envs needs ManiSkill's GPU simulation "
+                          f"(sim_backend physx_cuda) and this machine has no CUDA device: use n_envs: 1, "
+                          f"or vec_env: processes")
+    env = gym.make(env_id(config.category, maniskill=True), num_envs=config.n_envs, obs_mode=config.obs_mode,
+                   control_mode="pd_ee_delta_pose", sim_backend=backend, task=config.train_task(),
+                   max_episode_steps=config.max_episode_steps)
+    return ManiSkillVecEnv(BatchedOracleObservation(env, config.perception), config.continue_after_success,
+                           config.reconfigure_every_steps)
+
+
 def make_vec_env(config: PPOTrainConfig) -> VecEnv:
-    """``n_envs`` training envs: ``SubprocVecEnv`` (one process each) when > 1, else ``DummyVecEnv``;
-    not yet normalised or seeded (PPO seeds them with ``seed + rank``)."""
+    """``n_envs`` training envs: ``SubprocVecEnv`` (one process each) when > 1, else ``DummyVecEnv``,
+    or the batched ManiSkill env with ``vec_env: maniskill``; not yet normalised or seeded (PPO seeds
+    them with ``seed + rank``)."""
+    if config.vec_env == "maniskill":
+        return make_maniskill_vec_env(config)
     fns = [partial(make_train_env, config, rank) for rank in range(config.n_envs)]
     return SubprocVecEnv(fns) if config.n_envs > 1 else DummyVecEnv(fns)
 

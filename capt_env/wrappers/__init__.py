@@ -6,8 +6,11 @@
 - :mod:`~capt_env.wrappers.perception_sources`: oracle, noisy oracle and CAPT estimators.
 - :mod:`~capt_env.wrappers.joint_observation`: the flat / dict observation and its layout.
 - :mod:`~capt_env.wrappers.perception_wrapper`: :class:`CaptObservationWrapper`, tying them together.
+- :mod:`~capt_env.wrappers.batched_oracle_observation`: :class:`BatchedOracleObservation`, the same
+  observation from ground truth for a batched ManiSkill env (GPU simulation), as torch tensors.
 """
 
+from capt_env.wrappers.batched_oracle_observation import BatchedOracleObservation
 from capt_env.wrappers.config import IsolationConfig, NoiseConfig, PerceptionWrapperConfig
 from capt_env.wrappers.estimate import JointAxisEstimate
 from capt_env.wrappers.joint_observation import (
@@ -19,6 +22,7 @@ from capt_env.wrappers.perception_wrapper import CaptObservationWrapper
 
 __all__ = [
     "OBSERVATION_SIZE",
+    "BatchedOracleObservation",
     "CaptObservationWrapper",
     "IsolationConfig",
     "JointAxisEstimate",
