@@ -77,6 +77,16 @@ def away_from_joint(gt: dict[str, torch.Tensor]) -> torch.Tensor:
     return torch.where(gt["prismatic"].unsqueeze(-1), u, radial)
 
 
+def masked_update(old: dict[str, torch.Tensor] | None, new: dict[str, torch.Tensor], mask: torch.Tensor
+                  ) -> dict[str, torch.Tensor]:
+    """``new``'s rows where ``mask`` (b,) is set, ``old``'s elsewhere, for every (b,) or (b, n) entry;
+    ``new`` itself when there is no ``old``."""
+    if old is None:
+        return dict(new)
+    return {key: torch.where(mask if value.dim() == 1 else mask.unsqueeze(-1), value, old[key])
+            for key, value in new.items()}
+
+
 class BatchedOracleObservation(gym.Wrapper):
     """Flat joint-axis observations (num_envs, 38) from a batched ``CaptOpen*-ms-v0`` env.
 
@@ -154,12 +164,7 @@ class BatchedOracleObservation(gym.Wrapper):
         b = self.num_envs
         draw = {"tilt": self._normal(b, 3), "pivot": self._normal(b, 3), "grasp": _unit(self._normal(b, 3)),
                 "sign": torch.where(torch.rand(b, generator=self._gen, device=self.device) < 0.5, -1.0, 1.0)}
-        if self._held is None:
-            self._held = draw
-            return
-        for key, value in draw.items():
-            m = mask if value.dim() == 1 else mask.unsqueeze(-1)
-            self._held[key] = torch.where(m, value, self._held[key])
+        self._held = masked_update(self._held, draw, mask)
 
     def _noisy(self, gt: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
         n: NoiseConfig = self.config.noise
@@ -187,12 +192,7 @@ class BatchedOracleObservation(gym.Wrapper):
         """Estimate every sub-scene and keep the new estimate where ``mask`` is set."""
         gt = ground_truth(info)
         new = self._noisy(gt) if self.config.source == "noisy_oracle" else gt
-        if self._estimate is None:
-            self._estimate = new
-            return
-        for key, value in new.items():
-            m = mask if value.dim() == 1 else mask.unsqueeze(-1)
-            self._estimate[key] = torch.where(m, value, self._estimate[key])
+        self._estimate = masked_update(self._estimate, new, mask)
 
     def _observation(self) -> torch.Tensor:
         assert self._estimate is not None
