@@ -25,10 +25,14 @@ import json
 import statistics
 from pathlib import Path
 
+from perception.paired_comparison import METRICS as PAIRED_METRICS
 from perception.paired_comparison import PairedDifference, paired_differences
 
-METRICS = (("dir_med", "direction (deg)"), ("pos_aed", "position (normalised)"),
-           ("state_deg", "state, revolute (deg)"), ("state_m", "state, prismatic (m)"))
+# (key, column label); the keys are perception.paired_comparison's, in its order
+METRICS = tuple(zip(PAIRED_METRICS, ("direction (deg)", "position (normalised)", "state, revolute (deg)",
+                                     "state, prismatic (m)"), strict=True))
+TABLE_HEAD = ["| category | method | " + " | ".join(label for _, label in METRICS) + " |",
+              "|" + " --- |" * (len(METRICS) + 2)]
 
 
 def joint_mean(values: list[float | None]) -> float | None:
@@ -79,8 +83,7 @@ def _as_dict(d: PairedDifference | None) -> dict | None:
 
 
 def markdown(result: dict) -> str:
-    head = "| category | method | " + " | ".join(label for _, label in METRICS) + " |"
-    lines = [head, "|" + " --- |" * (len(METRICS) + 2)]
+    lines = list(TABLE_HEAD)
     rows = [*((c, result["categories"][c]) for c in sorted(result["categories"])), ("mean", result["mean"])]
     for cat, by_method in rows:
         for m in result["methods"]:
@@ -90,9 +93,7 @@ def markdown(result: dict) -> str:
         ref = result["reference"]
         lines += ["", f"{ref} minus each method, with a 95% paired bootstrap interval over the test clouds "
                   f"({result['draws']} draws, seed {result['seed']}; negative: {ref} has the lower "
-                  "error):", "",
-                  "| category | method | " + " | ".join(label for _, label in METRICS) + " |",
-                  "|" + " --- |" * (len(METRICS) + 2)]
+                  "error):", "", *TABLE_HEAD]
         for other, rows in result["paired"].items():
             for cat in [*sorted(c for c in rows if c != "mean"), "mean"]:
                 cells = ["-" if rows[cat][k] is None else _gap(rows[cat][k]) for k, _ in METRICS]

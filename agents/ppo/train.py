@@ -117,8 +117,7 @@ def make_maniskill_vec_env(config: PPOTrainConfig) -> VecEnv:
                           f"(sim_backend physx_cuda) and this machine has no CUDA device: use n_envs: 1, "
                           f"or vec_env: processes")
     env = gym.make(env_id(config.category, maniskill=True), num_envs=config.n_envs, obs_mode=config.obs_mode,
-                   control_mode="pd_ee_delta_pose", sim_backend=backend, task=config.train_task(),
-                   max_episode_steps=config.max_episode_steps)
+                   sim_backend=backend, task=config.train_task(), max_episode_steps=config.max_episode_steps)
     return ManiSkillVecEnv(BatchedOracleObservation(env, config.perception), config.continue_after_success,
                            config.reconfigure_every_steps)
 

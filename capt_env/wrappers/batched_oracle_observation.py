@@ -18,6 +18,10 @@ Each sub-scene looks at its reset and then every ``every_k_steps`` of its own st
 keeps its last estimate. A partial reset (``options={"env_idx": ...}``, as auto-resetting vector
 envs do) restarts only those sub-scenes' counters and noise. ``info`` gains ``perception_ran``
 ((num_envs,) bool). The ``capt`` source is not batched: it runs in the single-env wrapper.
+
+The helpers here (``canonical_pivot``, ``away_from_joint``, ``perpendicular``) are batched torch
+twins of the numpy ones in :mod:`capt_env.wrappers.estimate` and ``perception_sources``; the test
+that this observation equals the single-env wrapper's keeps them in step.
 """
 
 from __future__ import annotations
@@ -133,7 +137,8 @@ class BatchedOracleObservation(gym.Wrapper):
             self._gen.manual_seed(self.config.seed * 1_000_003 + first)
         mask = self._mask(options)
         self._steps[mask] = 0
-        self._draw_held(mask)
+        if self.config.source == "noisy_oracle" and self.config.noise.model == "fixed_offset":
+            self._draw_held(mask)
         self._look(info, mask)
         return self._observation(), self._info(info, mask)
 
