@@ -178,6 +178,7 @@ class TrainConfig:
         require(self.epochs >= 1, "epochs must be >= 1")
         require(self.batch_size >= 1, "batch_size must be >= 1")
         require(self.lr > 0.0, "lr must be > 0")
+        require(self.seed >= 0, f"seed must be >= 0, got {self.seed}")
         require(self.weight_decay >= 0.0, "weight_decay must be >= 0")
         require(self.num_workers >= 0, "num_workers must be >= 0")
         require(self.device == "auto" or self.device == "cpu" or self.device.startswith("cuda"),

@@ -8,6 +8,12 @@ table value exactly as the table does: per joint slot the mean over the clouds t
 then the mean over joint slots. The interval says how much the gap moves with the test clouds; it
 says nothing of training noise (another training seed can order two close methods the other way).
 
+Training runs (seeds) of one method on one category: samples may carry a ``"run"`` key (any label;
+absent counts as one run). Every run of a (category, method) must have scored the same clouds in the
+same order; their errors are averaged per cloud and joint before the table value and the bootstrap,
+so the gap is that of the methods' mean over runs, and the interval is still over the test clouds
+only (two runs do not measure the spread between seeds).
+
 Metrics (per-sample fields of ``capt evaluate --json``):
 
 - ``dir_med``: direction error, degrees, every joint;
@@ -99,15 +105,28 @@ def bootstrap_difference(pairs: Mapping[str, tuple[np.ndarray, np.ndarray]], dra
     return PairedDifference(float(np.mean(point)), float(low), float(high), float(np.mean(dist < 0.0)))
 
 
+def run_mean_error_matrix(runs: Mapping[object, Sequence[Mapping]], metric: str,
+                          where: str = "") -> np.ndarray:
+    """:func:`error_matrix` averaged over training runs (``{run label: samples}``) of one method on one
+    category; the runs must have scored the same number of clouds with the same joint slots."""
+    mats = [error_matrix(s, metric) for _, s in sorted(runs.items(), key=lambda kv: str(kv[0]))]
+    shapes = {m.shape for m in mats}
+    if len(shapes) != 1:
+        raise ValueError(f"{where}: its runs were scored on different clouds (error matrices "
+                         f"{sorted(shapes)}); evaluate every run on the same split of the same data")
+    return np.mean(mats, axis=0)
+
+
 def paired_differences(samples: Sequence[Mapping], reference: str, draws: int = 2000, seed: int = 0
                        ) -> dict[str, dict[str, dict[str, PairedDifference | None]]]:
     """``{other method: {category or "mean": {metric: PairedDifference or None}}}`` for every method
     scored on every category beside ``reference``, from the per-sample dicts of one or more
-    ``capt evaluate --json`` files (each category from one run). Seeded: the same input gives the same
+    ``capt evaluate --json`` files; several training runs of a method are averaged per cloud (the
+    samples' ``"run"`` key, see the module docstring). Seeded: the same input gives the same
     intervals."""
-    groups: dict[tuple[str, str], list[Mapping]] = {}
+    groups: dict[tuple[str, str], dict[object, list[Mapping]]] = {}
     for s in samples:
-        groups.setdefault((s["category"], s["method"]), []).append(s)
+        groups.setdefault((s["category"], s["method"]), {}).setdefault(s.get("run", 0), []).append(s)
     categories = sorted({c for c, _ in groups})
     if not any((c, reference) in groups for c in categories):
         raise ValueError(f"no samples of the reference method {reference!r}")
@@ -117,8 +136,9 @@ def paired_differences(samples: Sequence[Mapping], reference: str, draws: int = 
     for other in others:
         rows: dict[str, dict[str, PairedDifference | None]] = {c: {} for c in [*categories, "mean"]}
         for metric in METRICS:
-            pairs = {c: (error_matrix(groups[(c, reference)], metric),
-                         error_matrix(groups[(c, other)], metric)) for c in categories}
+            pairs = {c: (run_mean_error_matrix(groups[(c, reference)], metric, f"{c} {reference}"),
+                         run_mean_error_matrix(groups[(c, other)], metric, f"{c} {other}"))
+                     for c in categories}
             for c in categories:
                 rows[c][metric] = bootstrap_difference({c: pairs[c]}, draws, seed)
             rows["mean"][metric] = bootstrap_difference(pairs, draws, seed)

@@ -1,7 +1,10 @@
 """CAPT vs CAPT-plain vs direct-regression PCT across categories, from `capt evaluate --json` files.
 
 Each input file is one `capt evaluate` run that scored the three variants side by side on one
-category's test split. Prints, per category and as the mean over categories, the mean direction
+category's test split. Files that score the same method on the same category again are further
+training runs (e.g. another `capt train --seed`) of it, evaluated on the same data: its values are
+the mean over its runs, its method cell says how many, and the paired gaps use per-cloud errors
+averaged over runs. Prints, per category and as the mean over categories, the mean direction
 error (degrees), position error (normalised object frame), and state error, in degrees over revolute
 joints and in metres over prismatic ones (never averaged together), each first averaged over the
 category's joints. A joint without a position error is prismatic (``capt evaluate`` reports none for
@@ -53,17 +56,20 @@ def category_errors(s: dict) -> dict[str, float | None]:
 
 def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed: int = 0) -> dict:
     """{"methods": [...], "categories": {cat: {method: {metric: value}}}, "mean": {method: {...}},
+    "runs": {cat: {method: number of runs averaged}},
     "paired": {method: {cat or "mean": {metric: {difference, low, high, reference_lower_share}}}}}.
     ``paired`` is empty when ``draws`` is 0, when the files hold no per-sample results, or when the
     reference method is not in them."""
-    per_cat: dict[str, dict[str, dict[str, float | None]]] = {}
+    per_run: dict[str, dict[str, list[dict[str, float | None]]]] = {}
     samples: list[dict] = []
-    for path in paths:
+    for index, path in enumerate(paths):
         run = json.loads(path.read_text())
-        samples.extend(run.get("samples", []))
+        samples.extend({**s, "run": index} for s in run.get("samples", []))
         for method, cats in run["summary"].items():
             for cat, s in cats.items():
-                per_cat.setdefault(cat, {})[method] = category_errors(s)
+                per_run.setdefault(cat, {}).setdefault(method, []).append(category_errors(s))
+    per_cat = {c: {m: {k: joint_mean([r[k] for r in runs]) for k, _ in METRICS} for m, runs in by_m.items()}
+               for c, by_m in per_run.items()}
     methods = sorted(set.intersection(*(set(v) for v in per_cat.values())))
     if not methods:
         raise SystemExit("no method was evaluated on every category")
@@ -74,7 +80,8 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
         paired = {m: {c: {k: _as_dict(d) for k, d in by_metric.items()} for c, by_metric in rows.items()}
                   for m, rows in paired_differences(samples, reference, draws, seed).items()}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths],
-            "reference": reference, "draws": draws, "seed": seed, "paired": paired}
+            "reference": reference, "draws": draws, "seed": seed, "paired": paired,
+            "runs": {c: {m: len(runs) for m, runs in by_m.items()} for c, by_m in per_run.items()}}
 
 
 def _as_dict(d: PairedDifference | None) -> dict | None:
@@ -85,10 +92,13 @@ def _as_dict(d: PairedDifference | None) -> dict | None:
 def markdown(result: dict) -> str:
     lines = list(TABLE_HEAD)
     rows = [*((c, result["categories"][c]) for c in sorted(result["categories"])), ("mean", result["mean"])]
+    runs = result.get("runs", {})
     for cat, by_method in rows:
         for m in result["methods"]:
             cells = ["-" if by_method[m][k] is None else f"{by_method[m][k]:.4g}" for k, _ in METRICS]
-            lines.append(f"| {cat} | {m} | " + " | ".join(cells) + " |")
+            n = runs.get(cat, {}).get(m, 1)
+            label = f"{m} (mean of {n} runs)" if n > 1 else m
+            lines.append(f"| {cat} | {label} | " + " | ".join(cells) + " |")
     if result.get("paired"):
         ref = result["reference"]
         lines += ["", f"{ref} minus each method, with a 95% paired bootstrap interval over the test clouds "

@@ -15,6 +15,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, help="run directory: last.pt, best.pt, log.csv")
     parser.add_argument("--epochs", type=int, default=None, help="override the config's epochs")
     parser.add_argument("--device", default=None, help="auto, cpu or cuda[:i] (default: the config's)")
+    parser.add_argument("--seed", type=int, default=None,
+                        help="override the config's seed (weights, shuffling, augmentation)")
     parser.add_argument("--stop-after", type=int, default=None,
                         help="run at most this many epochs now; run again to resume")
     parser.add_argument("--no-resume", action="store_true", help="start over even if last.pt exists")
@@ -23,8 +25,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "ignored when resuming from last.pt")
 
 
-def train_config_for(config_path: str, data_dir: str, epochs: int | None, device: str | None):
-    """The YAML TrainConfig with the model's output channels set for the dataset's category."""
+def train_config_for(config_path: str, data_dir: str, epochs: int | None, device: str | None,
+                     seed: int | None = None):
+    """The YAML TrainConfig with the model's output channels set for the dataset's category, and the
+    command line's overrides (``None``: keep the config's)."""
 
     from capt_env.dataset.category_structure import category_structure
     from perception.config import TrainConfig
@@ -40,13 +44,15 @@ def train_config_for(config_path: str, data_dir: str, epochs: int | None, device
         cfg["epochs"] = epochs
     if device is not None:
         cfg["device"] = device
+    if seed is not None:
+        cfg["seed"] = seed
     return from_dict(TrainConfig, cfg), category
 
 
 def run(args: argparse.Namespace) -> int:
     from perception.training import train
 
-    cfg, category = train_config_for(args.config, args.data, args.epochs, args.device)
+    cfg, category = train_config_for(args.config, args.data, args.epochs, args.device, args.seed)
     result = train(cfg, args.data, args.out, resume=not args.no_resume, stop_after=args.stop_after,
                    init_from=args.init_from)
     print(f"{category} {cfg.model.model.variant}: {result.epochs_run}/{cfg.epochs} epochs, "
@@ -54,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
           f"best checkpoint {result.best_path}")
     write_json(args.json, {
         "category": category, "variant": cfg.model.model.variant, "epochs_run": result.epochs_run,
-        "epochs": cfg.epochs, "best_val_loss": result.best_val_loss,
+        "epochs": cfg.epochs, "seed": cfg.seed, "best_val_loss": result.best_val_loss,
         "voting_window": list(result.voting_window), "best_path": str(result.best_path),
         "log": str(result.log_path), "init_from": args.init_from,
         "epoch_seconds": epoch_seconds(result.log_path),

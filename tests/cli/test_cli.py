@@ -143,3 +143,20 @@ def test_estimate_errors_hinge_on_door_edge_beats_capt_line(tmp_path: Path) -> N
     assert all(r["line_m"] < 0.05 for r in on["per_reset"])
     assert on["line_m_mean"] < 0.5 * off["line_m_mean"]
     assert on["direction_deg_mean"] < off["direction_deg_mean"]
+
+
+def test_train_config_takes_the_command_line_overrides(tmp_path: Path) -> None:
+    from capt_env.commands.train import train_config_for
+    from perception.yaml_config import ConfigError
+
+    data = tmp_path / "data"
+    data.mkdir()
+    (data / "manifest.json").write_text(json.dumps({"config": {"category": "eyeglasses"}}))
+    cfg, category = train_config_for("configs/perception/capt.yaml", str(data), 3, "cpu", 7)
+    assert category == "eyeglasses"
+    assert (cfg.epochs, cfg.device, cfg.seed) == (3, "cpu", 7)
+    assert cfg.model.model.max_joints == 2  # the eyeglasses' two temples
+    kept, _ = train_config_for("configs/perception/capt.yaml", str(data), None, None)
+    assert (kept.epochs, kept.seed) == (30, 0)  # the YAML's
+    with pytest.raises(ConfigError, match="seed"):
+        train_config_for("configs/perception/capt.yaml", str(data), None, None, -1)

@@ -83,3 +83,40 @@ def test_paired_gaps_from_per_sample_results(tmp_path):
     assert cv.compare([path], draws=0)["paired"] == {}
     summary_only = _write(tmp_path / "s.json", "laptop", {m: v["laptop"] for m, v in run["summary"].items()})
     assert cv.compare([summary_only])["paired"] == {}
+
+
+def _run_file(path: Path, offsets: dict[str, float], n: int = 30) -> Path:
+    """One `capt evaluate --json`-shaped laptop run: method m's direction error on cloud i is
+    i + offsets[m] degrees."""
+    samples = [{"category": "laptop", "method": m, "joints": [
+        {"joint_index": 0, "joint_type": "revolute", "direction_error_deg": i + off, "position_error": 0.01,
+         "state_error": 3.0}]} for i in range(n) for m, off in offsets.items()]
+    mean = (n - 1) / 2
+    summary = {m: {"laptop": {"dir_med": [mean + off], "pos_aed": [0.01], "state_med": [3.0]}}
+               for m, off in offsets.items()}
+    path.write_text(json.dumps({"summary": summary, "samples": samples}))
+    return path
+
+
+def test_two_training_runs_of_each_method_are_averaged(tmp_path):
+    """Seed 0 has CAPT 1 deg worse on every cloud, seed 1 has it 3 deg better: the mean over runs is
+    1 deg better, in the table and in the paired gap (whose per-cloud average makes it exact)."""
+    cv = _load()
+    seed0 = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
+    seed1 = _run_file(tmp_path / "seed1.json", {"capt": 0.0, "capt_plain": 3.0})
+    result = cv.compare([seed0, seed1], draws=200, seed=0)
+    assert result["runs"] == {"laptop": {"capt": 2, "capt_plain": 2}}
+    assert result["categories"]["laptop"]["capt"]["dir_med"] == pytest.approx(14.5 + 0.5)
+    assert result["categories"]["laptop"]["capt_plain"]["dir_med"] == pytest.approx(14.5 + 1.5)
+    gap = result["paired"]["capt_plain"]["mean"]["dir_med"]
+    assert gap["difference"] == pytest.approx(-1.0)
+    assert gap["low"] == pytest.approx(-1.0) and gap["high"] == pytest.approx(-1.0)
+    assert "| laptop | capt (mean of 2 runs) | 15 |" in cv.markdown(result)
+
+
+def test_runs_scored_on_different_clouds_are_refused(tmp_path):
+    cv = _load()
+    seed0 = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0}, n=30)
+    seed1 = _run_file(tmp_path / "seed1.json", {"capt": 0.0, "capt_plain": 3.0}, n=20)
+    with pytest.raises(ValueError, match="laptop capt: its runs were scored on different clouds"):
+        cv.compare([seed0, seed1], draws=10)
