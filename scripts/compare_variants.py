@@ -127,6 +127,9 @@ def main() -> None:
     args = parser.parse_args()
     if args.draws < 0:
         parser.error(f"--draws must be >= 0, got {args.draws}")
+    missing = [str(p) for p in args.inputs if not p.is_file()]
+    if missing:
+        parser.error(f"no such capt evaluate --json file: {', '.join(missing)}")
     result = compare(args.inputs, args.reference, args.draws, args.seed)
     table = markdown(result)
     print(table, end="")

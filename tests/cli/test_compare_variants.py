@@ -120,3 +120,13 @@ def test_runs_scored_on_different_clouds_are_refused(tmp_path):
     seed1 = _run_file(tmp_path / "seed1.json", {"capt": 0.0, "capt_plain": 3.0}, n=20)
     with pytest.raises(ValueError, match="laptop capt: its runs were scored on different clouds"):
         cv.compare([seed0, seed1], draws=10)
+
+
+def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys):
+    cv = _load()
+    present = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
+    monkeypatch.setattr("sys.argv", ["compare_variants.py", str(present), str(tmp_path / "nope.json")])
+    with pytest.raises(SystemExit):
+        cv.main()
+    err = capsys.readouterr().err
+    assert "no such capt evaluate --json file:" in err and "nope.json" in err and "seed0.json" not in err
