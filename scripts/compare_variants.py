@@ -4,11 +4,12 @@ Each input file is one `capt evaluate` run that scored the three variants side b
 category's test split. Files that score the same method on the same category again are further
 training runs (e.g. another `capt train --seed`) of it, evaluated on the same data: its values are
 the mean over its runs, its method cell says how many, and the paired gaps use per-cloud errors
-averaged over runs. Prints, per category and as the mean over categories, the mean direction
-error (degrees), position error (normalised object frame), and state error, in degrees over revolute
-joints and in metres over prismatic ones (never averaged together), each first averaged over the
-category's joints. A joint without a position error is prismatic (``capt evaluate`` reports none for
-them). A mean over no value (e.g. position when every category is prismatic) is "-".
+averaged over runs (a file given twice is an error). Prints, per category and as the mean over
+categories, the mean direction error (degrees), position error (normalised object frame), and state
+error, in degrees over revolute joints and in metres over prismatic ones (never averaged together),
+each first averaged over the category's joints. A joint without a position error is prismatic
+(``capt evaluate`` reports none for them). A mean over no value (e.g. position when every category
+is prismatic) is "-".
 
 Then, for every method beside the reference (``--reference``, default ``capt``), the paired gap
 reference minus method on each category and on the mean, with a 95% bootstrap interval over the test
@@ -130,6 +131,10 @@ def main() -> None:
     missing = [str(p) for p in args.inputs if not p.is_file()]
     if missing:
         parser.error(f"no such capt evaluate --json file: {', '.join(missing)}")
+    resolved = [p.resolve() for p in args.inputs]
+    twice = sorted({str(p) for p, r in zip(args.inputs, resolved, strict=True) if resolved.count(r) > 1})
+    if twice:
+        parser.error(f"an input is given twice (it would count as two training runs): {', '.join(twice)}")
     result = compare(args.inputs, args.reference, args.draws, args.seed)
     table = markdown(result)
     print(table, end="")

@@ -130,3 +130,12 @@ def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys):
         cv.main()
     err = capsys.readouterr().err
     assert "no such capt evaluate --json file:" in err and "nope.json" in err and "seed0.json" not in err
+
+
+def test_an_input_given_twice_is_refused(tmp_path, monkeypatch, capsys):
+    cv = _load()
+    run = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
+    monkeypatch.setattr("sys.argv", ["compare_variants.py", str(run), str(tmp_path / "." / "seed0.json")])
+    with pytest.raises(SystemExit):
+        cv.main()
+    assert "given twice" in capsys.readouterr().err
