@@ -105,11 +105,10 @@ def bootstrap_difference(pairs: Mapping[str, tuple[np.ndarray, np.ndarray]], dra
     return PairedDifference(float(np.mean(point)), float(low), float(high), float(np.mean(dist < 0.0)))
 
 
-def run_mean_error_matrix(runs: Mapping[object, Sequence[Mapping]], metric: str,
-                          where: str = "") -> np.ndarray:
+def run_mean_error_matrix(runs: Mapping[object, Sequence[Mapping]], metric: str, where: str) -> np.ndarray:
     """:func:`error_matrix` averaged over training runs (``{run label: samples}``) of one method on one
     category; the runs must have scored the same number of clouds with the same joint slots."""
-    mats = [error_matrix(s, metric) for _, s in sorted(runs.items(), key=lambda kv: str(kv[0]))]
+    mats = [error_matrix(s, metric) for s in runs.values()]
     shapes = {m.shape for m in mats}
     if len(shapes) != 1:
         raise ValueError(f"{where}: its runs were scored on different clouds (error matrices "

@@ -40,12 +40,9 @@ def train_config_for(config_path: str, data_dir: str, epochs: int | None, device
     category = json.loads(manifest.read_text())["config"]["category"]
     cfg = to_dict(load_yaml(TrainConfig, config_path))
     cfg["model"]["model"].update(category_structure(category))
-    if epochs is not None:
-        cfg["epochs"] = epochs
-    if device is not None:
-        cfg["device"] = device
-    if seed is not None:
-        cfg["seed"] = seed
+    for key, value in {"epochs": epochs, "device": device, "seed": seed}.items():
+        if value is not None:
+            cfg[key] = value
     return from_dict(TrainConfig, cfg), category
 
 
