@@ -61,23 +61,35 @@ def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg
     return SampleResult(sample.category, method, pa, miou, tuple(joints), est.latency_ms)
 
 
+WITHOUT_DV = "capt_without_dv"
+
+
 def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str = "test",
              device: str = "cpu", timing_clouds: int = 100, max_samples: int | None = None,
-             progress: bool = True) -> EvaluationResult:
+             progress: bool = True, without_double_voting: bool = False) -> EvaluationResult:
     """Evaluate each checkpoint on ``split``. The method name is the checkpoint's model variant, or
     ``"<variant> (<path>)"`` for every checkpoint whose variant is given more than once (e.g. two CAPT
-    checkpoints compared), so no row overwrites another. Timing is the median of ``predict`` latency
-    over at least ``timing_clouds`` single-cloud calls (cycling over the split if it is smaller), after
-    3 warm-up calls."""
+    checkpoints compared), so no row overwrites another. ``without_double_voting`` also scores every
+    CAPT checkpoint with the coarse vote only, as method ``capt_without_dv`` (the paper's "CAPT w/o
+    DV": the motion loss's training without double voting's inference). Timing is the median of
+    ``predict`` latency over at least ``timing_clouds`` single-cloud calls (cycling over the split if it
+    is smaller), after 3 warm-up calls."""
     if len({str(p) for p in checkpoints}) != len(checkpoints):
         raise ValueError(f"a checkpoint is given twice: {[str(p) for p in checkpoints]}")
     estimators = [ArticulationEstimator.from_checkpoint(path, device=device) for path in checkpoints]
     variants = [e.config.model.variant for e in estimators]
+    runs: list[tuple[str, ArticulationEstimator]] = []
+    for path, est, variant in zip(checkpoints, estimators, variants, strict=True):
+        suffix = "" if variants.count(variant) == 1 else f" ({path})"
+        runs.append((variant + suffix, est))
+        if without_double_voting and variant == "capt":
+            runs.append((WITHOUT_DV + suffix,
+                         ArticulationEstimator(est.model, est.config, est.voting_window, est.category, device,
+                                               est.seed, double_voting=False)))
     results: list[SampleResult] = []
     median_ms: dict[str, float] = {}
-    for path, est, variant in zip(checkpoints, estimators, variants, strict=True):
+    for method, est in runs:
         cfg = est.config.model
-        method = variant if variants.count(variant) == 1 else f"{variant} ({path})"
         ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples)
         samples = [ds.sample(i) for i in range(len(ds))]
         clouds = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]

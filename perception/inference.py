@@ -95,7 +95,19 @@ class ArticulationEstimator:
     """A trained CAPT model plus its voting window, ready to estimate articulation from clouds."""
 
     def __init__(self, model: CaptModel, config: CaptConfig, voting_window: tuple[float, float] | None = None,
-                 category: str = "", device: str | torch.device = "cpu", seed: int = 0) -> None:
+                 category: str = "", device: str | torch.device = "cpu", seed: int = 0,
+                 double_voting: bool | None = None) -> None:
+        """``double_voting``: None votes as the variant was trained to (CAPT twice, CAPT-plain once);
+        False makes a CAPT checkpoint vote once, the coarse mean (the paper's "CAPT w/o DV"). True is
+        only for CAPT: its voting window was chosen on validation, CAPT-plain's never was."""
+        variant = config.model.variant
+        if double_voting is not None and variant == "pct_regression":
+            raise ValueError("double_voting does not apply to a pct_regression checkpoint: it regresses "
+                             "the joints directly and does not vote")
+        if double_voting and variant != "capt":
+            raise ValueError(f"double_voting=True needs a capt checkpoint (its voting window is chosen on "
+                             f"validation); this one is {variant}")
+        self.double_voting = config.double_voting if double_voting is None else double_voting
         self.config = config
         self.device = torch.device(device)
         self.model = model.to(self.device).eval()
@@ -105,11 +117,13 @@ class ArticulationEstimator:
         self.joint_types = tuple(config.model.joint_types)
 
     @classmethod
-    def from_checkpoint(cls, path: str | Path, device: str | torch.device = "cpu", seed: int = 0
-                        ) -> ArticulationEstimator:
-        """Load a checkpoint written by :func:`perception.checkpoint.save_checkpoint`."""
+    def from_checkpoint(cls, path: str | Path, device: str | torch.device = "cpu", seed: int = 0,
+                        double_voting: bool | None = None) -> ArticulationEstimator:
+        """Load a checkpoint written by :func:`perception.checkpoint.save_checkpoint`
+        (``double_voting`` as in the constructor)."""
         ckpt = load_checkpoint(path)
-        return cls(build_model(ckpt, device), ckpt.config, ckpt.voting_window, ckpt.category, device, seed)
+        return cls(build_model(ckpt, device), ckpt.config, ckpt.voting_window, ckpt.category, device, seed,
+                   double_voting)
 
     def predict(self, points: np.ndarray) -> ArticulationEstimate:
         """Estimate segmentation and joints of one cloud ``points`` (N, 3) float, metres, any frame."""
@@ -154,7 +168,7 @@ class ArticulationEstimator:
             pred = PointPredictions(net_points, arr(out.dir), arr(out.dist), arr(out.pdir), arr(out.state),
                                     child)
             w0, w1 = self.voting_window
-            votes = vote(pred, codes, w0, w1, self.config.double_voting, self.config.voting.min_points)
+            votes = vote(pred, codes, w0, w1, self.double_voting, self.config.voting.min_points)
             raw = [(v.direction, v.pivot, v.state, v.confidence) for v in votes]
         else:
             assert out.reg_dir is not None and out.reg_pivot is not None and out.reg_state is not None

@@ -17,6 +17,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-samples", type=int, default=None)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
     parser.add_argument("--figures", default=None, help="save a cloud+axes PNG per checkpoint here")
+    parser.add_argument("--without-double-voting", action="store_true",
+                        help="also score each CAPT checkpoint with the coarse vote only, as method "
+                             "capt_without_dv (the paper's 'CAPT w/o DV')")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -26,7 +29,8 @@ def run(args: argparse.Namespace) -> int:
     from perception.metrics import summarise
 
     result = evaluate(args.checkpoints, args.data, split=args.split, device=args.device,
-                      timing_clouds=args.timing_clouds, max_samples=args.max_samples)
+                      timing_clouds=args.timing_clouds, max_samples=args.max_samples,
+                      without_double_voting=args.without_double_voting)
     timing = "\n".join(f"| {m} | {ms:.1f} |" for m, ms in result.median_ms.items())
     text = (f"{result.table}\n\nTime per input (median over >= {args.timing_clouds} clouds, "
             f"device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")

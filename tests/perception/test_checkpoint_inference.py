@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from unittest import mock
 
@@ -95,6 +96,26 @@ def test_predict_regression_variant_and_prismatic_states(tmp_path):
     assert (r.part_labels == -1).all() and r.joints[0].type == "prismatic"
     r2 = est.predict(pts * 2.0)  # prismatic states are lengths: they scale with the cloud
     assert r2.joints[0].state == pytest.approx(2.0 * r.joints[0].state, rel=1e-4, abs=1e-6)
+
+
+def test_double_voting_can_be_switched_off_for_capt_only(tmp_path):
+    path, model, cfg = _save(tmp_path)
+    pts = make_samples(1, num_points=300)[0].points.astype(np.float64)
+    fine = ArticulationEstimator.from_checkpoint(path).predict(pts).joints[0]
+    coarse_est = ArticulationEstimator.from_checkpoint(path, double_voting=False)
+    coarse = coarse_est.predict(pts).joints[0]
+    # The same weights read as CAPT-plain vote once, over all points: exactly "CAPT w/o DV".
+    plain_cfg = CaptConfig(model=replace(cfg.model, variant="capt_plain"))
+    plain = ArticulationEstimator(model, plain_cfg, (0.4, 1.8)).predict(pts).joints[0]
+    assert np.allclose(coarse.direction, plain.direction) and np.allclose(coarse.pivot, plain.pivot)
+    assert coarse.state == pytest.approx(plain.state) and coarse.confidence == pytest.approx(plain.confidence)
+    assert not np.allclose(fine.pivot, coarse.pivot)  # the fine vote keeps a subset of the points
+    assert coarse_est.double_voting is False and ArticulationEstimator.from_checkpoint(path).double_voting
+    with pytest.raises(ValueError, match="needs a capt checkpoint"):
+        ArticulationEstimator(model, plain_cfg, double_voting=True)
+    pct_path, _, _ = _save(tmp_path, "pct_regression")
+    with pytest.raises(ValueError, match="does not vote"):
+        ArticulationEstimator.from_checkpoint(pct_path, double_voting=False)
 
 
 @pytest.mark.parametrize(

@@ -55,6 +55,17 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     assert all(r.pa is not None for r in ev.results if r.method == "capt")
     assert "| box_revolute | capt |" in ev.table and "| box_revolute | pct_regression | - | - |" in ev.table
 
+    # the paper's "CAPT w/o DV": the CAPT checkpoint scored again with the coarse vote only
+    ablation = evaluate([resumed.best_path, plain.best_path], data_dir, "test", timing_clouds=3,
+                        progress=False, without_double_voting=True)
+    rows = {m: [r for r in ablation.results if r.method == m] for m in ablation.median_ms}
+    assert set(rows) == {"capt", "capt_without_dv", "pct_regression"} and len(ablation.results) == 12
+    before = [r for r in ev.results if r.method == "capt"]
+    assert [r.joints for r in rows["capt"]] == [r.joints for r in before]  # the double-voted row as before
+    assert [r.pa for r in rows["capt_without_dv"]] == [r.pa for r in rows["capt"]]  # same segmentation
+    assert [r.joints for r in rows["capt_without_dv"]] != [r.joints for r in rows["capt"]]
+    assert "| box_revolute | capt_without_dv |" in ablation.table
+
     # two checkpoints of one variant (e.g. before and after fine-tuning) keep a row each
     two = evaluate([resumed.best_path, straight.last_path], data_dir, "test", timing_clouds=3,
                    progress=False)
