@@ -78,6 +78,9 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
         raise ValueError(f"a checkpoint is given twice: {[str(p) for p in checkpoints]}")
     estimators = [ArticulationEstimator.from_checkpoint(path, device=device) for path in checkpoints]
     variants = [e.config.model.variant for e in estimators]
+    if without_double_voting and "capt" not in variants:
+        raise ValueError(f"without_double_voting needs a capt checkpoint to score without double voting; "
+                         f"these are {variants}")
     runs: list[tuple[str, ArticulationEstimator]] = []
     for path, est, variant in zip(checkpoints, estimators, variants, strict=True):
         suffix = "" if variants.count(variant) == 1 else f" ({path})"

@@ -65,6 +65,8 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     assert [r.pa for r in rows["capt_without_dv"]] == [r.pa for r in rows["capt"]]  # same segmentation
     assert [r.joints for r in rows["capt_without_dv"]] != [r.joints for r in rows["capt"]]
     assert "| box_revolute | capt_without_dv |" in ablation.table
+    with pytest.raises(ValueError, match="needs a capt checkpoint"):
+        evaluate([plain.best_path], data_dir, "test", progress=False, without_double_voting=True)
 
     # two checkpoints of one variant (e.g. before and after fine-tuning) keep a row each
     two = evaluate([resumed.best_path, straight.last_path], data_dir, "test", timing_clouds=3,
