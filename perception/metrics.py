@@ -106,7 +106,8 @@ class JointResult:
 
 @dataclass(frozen=True)
 class SampleResult:
-    """Metrics of one evaluated cloud; ``pa``/``miou`` None when the method has no segmentation."""
+    """Metrics of one evaluated cloud; ``pa``/``miou`` None when the method has no segmentation;
+    ``instance_id`` the object instance the cloud shows (a test split has several views of each)."""
 
     category: str
     method: str
@@ -114,6 +115,7 @@ class SampleResult:
     miou: float | None
     joints: tuple[JointResult, ...] = field(default_factory=tuple)
     time_ms: float | None = None
+    instance_id: int | None = None
 
 
 def _share_above(errors: Sequence[float], threshold: float) -> float:

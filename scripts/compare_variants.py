@@ -15,7 +15,9 @@ Then, for every method beside the reference (``--reference``, default ``capt``),
 reference minus method on each category and on the mean, with a 95% bootstrap interval over the test
 clouds (``perception/paired_comparison.py``; ``--draws``, ``--seed``): negative means the reference
 has the lower error, and an interval that excludes 0 means the gap is more than the luck of which
-clouds are in the test split (it does not measure training noise).
+clouds are in the test split (it does not measure training noise). ``--resample instances`` draws
+the test instances instead, with all their views (needs the samples' ``instance_id``): the luck of
+which objects are in the test split.
 
     .venv/bin/python scripts/compare_variants.py benchmarks/perception_laptop.json \
         benchmarks/perception_oven.json --markdown benchmarks/variants_mean.md \
@@ -30,7 +32,7 @@ import statistics
 from pathlib import Path
 
 from perception.paired_comparison import METRICS as PAIRED_METRICS
-from perception.paired_comparison import PairedDifference, paired_differences
+from perception.paired_comparison import RESAMPLE_UNITS, PairedDifference, paired_differences
 
 # (key, column label); the keys are perception.paired_comparison's, in its order
 METRICS = tuple(zip(PAIRED_METRICS, ("direction (deg)", "position (normalised)", "state, revolute (deg)",
@@ -55,7 +57,8 @@ def category_errors(s: dict) -> dict[str, float | None]:
             "state_m": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if not r])}
 
 
-def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed: int = 0) -> dict:
+def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed: int = 0,
+            resample: str = "clouds") -> dict:
     """{"methods": [...], "categories": {cat: {method: {metric: value}}}, "mean": {method: {...}},
     "runs": {cat: {method: number of runs averaged}},
     "paired": {method: {cat or "mean": {metric: {difference, low, high, reference_lower_share}}}}}.
@@ -79,9 +82,9 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     paired: dict = {}
     if draws > 0 and any(x["method"] == reference for x in samples):
         paired = {m: {c: {k: _as_dict(d) for k, d in by_metric.items()} for c, by_metric in rows.items()}
-                  for m, rows in paired_differences(samples, reference, draws, seed).items()}
+                  for m, rows in paired_differences(samples, reference, draws, seed, resample).items()}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths],
-            "reference": reference, "draws": draws, "seed": seed, "paired": paired,
+            "reference": reference, "draws": draws, "seed": seed, "resample": resample, "paired": paired,
             "runs": {c: {m: len(runs) for m, runs in by_m.items()} for c, by_m in per_run.items()}}
 
 
@@ -102,7 +105,9 @@ def markdown(result: dict) -> str:
             lines.append(f"| {cat} | {label} | " + " | ".join(cells) + " |")
     if result.get("paired"):
         ref = result["reference"]
-        lines += ["", f"{ref} minus each method, with a 95% paired bootstrap interval over the test clouds "
+        unit = ("the test instances (every view of a drawn instance)"
+                if result.get("resample") == "instances" else "the test clouds")
+        lines += ["", f"{ref} minus each method, with a 95% paired bootstrap interval over {unit} "
                   f"({result['draws']} draws, seed {result['seed']}; negative: {ref} has the lower "
                   "error):", "", *TABLE_HEAD]
         for other, rows in result["paired"].items():
@@ -125,6 +130,9 @@ def main() -> None:
                         help="method whose gaps to the others are bootstrapped")
     parser.add_argument("--draws", type=int, default=2000, help="bootstrap draws (0: no paired gaps)")
     parser.add_argument("--seed", type=int, default=0, help="bootstrap seed")
+    parser.add_argument("--resample", choices=RESAMPLE_UNITS, default="clouds",
+                        help="what a bootstrap draw resamples: test clouds, or test instances with all "
+                             "their views (needs instance ids in the files)")
     args = parser.parse_args()
     if args.draws < 0:
         parser.error(f"--draws must be >= 0, got {args.draws}")
@@ -135,7 +143,10 @@ def main() -> None:
     twice = sorted({str(p) for p, r in zip(args.inputs, resolved, strict=True) if resolved.count(r) > 1})
     if twice:
         parser.error(f"an input is given twice (it would count as two training runs): {', '.join(twice)}")
-    result = compare(args.inputs, args.reference, args.draws, args.seed)
+    try:
+        result = compare(args.inputs, args.reference, args.draws, args.seed, args.resample)
+    except ValueError as err:
+        parser.error(str(err))
     table = markdown(result)
     print(table, end="")
     if args.markdown:

@@ -11,8 +11,10 @@ import pytest
 from perception.paired_comparison import (
     bootstrap_difference,
     error_matrix,
+    instance_draw_weights,
     paired_differences,
     table_value,
+    weighted_table_value,
 )
 
 BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
@@ -105,3 +107,65 @@ def test_paired_differences_over_methods_and_categories():
     assert result["capt_plain"]["mean"]["state_m"] is None
     with pytest.raises(ValueError, match="reference method 'oracle'"):
         paired_differences(samples, "oracle")
+
+
+def test_weighted_table_value_counts_each_cloud_as_often_as_drawn():
+    errors = np.array([[1.0, np.nan], [3.0, 10.0], [np.nan, 20.0]])
+    # cloud 0 twice, cloud 2 once: joint 0 mean (1 + 1) / 2, joint 1 mean 20 -> (1 + 20) / 2
+    w = np.array([[2.0, 0.0, 1.0], [1.0, 1.0, 1.0]])
+    np.testing.assert_allclose(weighted_table_value(errors, w), [10.5, table_value(errors)])
+    rng = np.random.default_rng(0)
+    idx = rng.integers(0, 3, size=(50, 3))
+    counts = np.stack([np.bincount(r, minlength=3) for r in idx]).astype(float)
+    np.testing.assert_allclose(weighted_table_value(errors, counts), table_value(errors[idx]))
+
+
+def test_instance_draws_take_every_cloud_of_a_drawn_instance():
+    ids = np.array([7, 7, 7, 3, 3, 9])
+    w = instance_draw_weights(ids, 200, np.random.default_rng(1))
+    assert w.shape == (200, 6)
+    assert (w[:, 0] == w[:, 1]).all() and (w[:, 1] == w[:, 2]).all() and (w[:, 3] == w[:, 4]).all()
+    # three instances drawn per draw
+    assert (w[:, [0, 3, 5]].sum(axis=1) == 3).all()
+
+
+def test_one_cloud_per_instance_gives_the_cloud_bootstrap():
+    rng = np.random.default_rng(5)
+    other = rng.uniform(0.0, 10.0, size=(40, 1))
+    ref = other + rng.normal(0.0, 1.0, size=(40, 1))
+    pairs = {"c": (ref, other)}
+    clouds = bootstrap_difference(pairs, draws=300, seed=2)
+    instances = bootstrap_difference(pairs, draws=300, seed=2, instances={"c": np.arange(40)})
+    assert (instances.low, instances.high) == pytest.approx((clouds.low, clouds.high))
+
+
+def test_views_of_one_instance_that_err_together_widen_the_interval():
+    """10 instances x 5 views whose gap is the instance's (views agree): resampling clouds treats 50
+    agreeing views as 50 independent clouds; resampling instances sees 10, an interval about sqrt(5)
+    times wider."""
+    rng = np.random.default_rng(7)
+    per_instance = rng.normal(0.0, 1.0, size=10)
+    gap = np.repeat(per_instance, 5)[:, None]
+    other = rng.uniform(5.0, 6.0, size=(50, 1))
+    pairs = {"c": (other + gap, other)}
+    clouds = bootstrap_difference(pairs, draws=2000, seed=0)
+    inst = bootstrap_difference(pairs, draws=2000, seed=0, instances={"c": np.repeat(np.arange(10), 5)})
+    assert clouds.difference == inst.difference
+    ratio = (inst.high - inst.low) / (clouds.high - clouds.low)
+    assert 1.7 < ratio < 3.0
+
+
+def test_instance_resampling_needs_matching_instance_ids():
+    a = [dict(_sample("c", m, [(0, "revolute", 1.0 + i, 0.1, 2.0)]), instance_id=i // 2)
+         for m in ("capt", "plain") for i in range(4)]
+    out = paired_differences(a, "capt", draws=100, resample="instances")
+    assert out["plain"]["c"]["dir_med"] is not None
+    missing = [dict(x) for x in a]
+    del missing[5]["instance_id"]
+    with pytest.raises(ValueError, match="without an instance_id"):
+        paired_differences(missing, "capt", draws=10, resample="instances")
+    other = [dict(x, instance_id=x["instance_id"] + (x["method"] == "plain")) for x in a]
+    with pytest.raises(ValueError, match="other instances"):
+        paired_differences(other, "capt", draws=10, resample="instances")
+    with pytest.raises(ValueError, match="resample must be"):
+        paired_differences(a, "capt", draws=10, resample="objects")
