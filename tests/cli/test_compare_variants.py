@@ -139,3 +139,22 @@ def test_an_input_given_twice_is_refused(tmp_path, monkeypatch, capsys):
     with pytest.raises(SystemExit):
         cv.main()
     assert "given twice" in capsys.readouterr().err
+
+
+def test_resampling_instances_needs_their_ids_and_says_so(tmp_path, monkeypatch, capsys):
+    cv = _load()
+    run = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
+    monkeypatch.setattr("sys.argv", ["compare_variants.py", str(run), "--resample", "instances"])
+    with pytest.raises(SystemExit):
+        cv.main()
+    assert "without an instance_id" in capsys.readouterr().err
+    data = json.loads(run.read_text())
+    for i, s in enumerate(s for s in data["samples"] if s["method"] == "capt"):
+        s["instance_id"] = i // 3
+    for i, s in enumerate(s for s in data["samples"] if s["method"] == "capt_plain"):
+        s["instance_id"] = i // 3
+    run.write_text(json.dumps(data))
+    result = cv.compare([run], draws=100, resample="instances")
+    assert result["resample"] == "instances"
+    assert result["paired"]["capt_plain"]["mean"]["dir_med"]["difference"] == pytest.approx(1.0)
+    assert "interval over the test instances (every view of a drawn instance)" in cv.markdown(result)
