@@ -25,12 +25,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import dataclasses
 
+    from perception.checkpoint import CheckpointError
     from perception.evaluation import evaluate
     from perception.metrics import summarise
 
-    result = evaluate(args.checkpoints, args.data, split=args.split, device=args.device,
-                      timing_clouds=args.timing_clouds, max_samples=args.max_samples,
-                      without_double_voting=args.without_double_voting)
+    try:
+        result = evaluate(args.checkpoints, args.data, split=args.split, device=args.device,
+                          timing_clouds=args.timing_clouds, max_samples=args.max_samples,
+                          without_double_voting=args.without_double_voting)
+    except (ValueError, CheckpointError, FileNotFoundError) as err:
+        raise SystemExit(f"capt evaluate: {err}") from err
     timing = "\n".join(f"| {m} | {ms:.1f} |" for m, ms in result.median_ms.items())
     text = (f"{result.table}\n\nTime per input (median over >= {args.timing_clouds} clouds, "
             f"device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")

@@ -160,3 +160,13 @@ def test_train_config_takes_the_command_line_overrides(tmp_path: Path) -> None:
     assert (kept.epochs, kept.seed) == (30, 0)  # the YAML's
     with pytest.raises(ConfigError, match="seed"):
         train_config_for("configs/perception/capt.yaml", str(data), None, None, -1)
+
+
+def test_evaluate_names_bad_input_without_a_traceback(tmp_path: Path) -> None:
+    shipped = str(Path(__file__).resolve().parents[2] / "perception" / "checkpoints" / "oven.pt")
+    with pytest.raises(SystemExit, match="capt evaluate: a checkpoint is given twice"):
+        main(["evaluate", shipped, shipped, "--data", str(tmp_path)])
+    with pytest.raises(SystemExit, match="capt evaluate: .*not found"):
+        main(["evaluate", str(tmp_path / "missing.pt"), "--data", str(tmp_path)])
+    with pytest.raises(SystemExit, match="capt evaluate: no shard_"):
+        main(["evaluate", shipped, "--data", str(tmp_path)])
