@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
@@ -12,15 +11,6 @@ import pytest
 from perception.data import write_dataset
 from perception.synthetic import make_box_sample
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "attach_instance_ids.py"
-
-
-def _load():
-    spec = importlib.util.spec_from_file_location("attach_instance_ids", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
 
 def _run(path: Path, n: int, category: str = "box_revolute") -> Path:
     samples = [{"category": category, "method": m, "joints": [], "error": i}
@@ -29,21 +19,21 @@ def _run(path: Path, n: int, category: str = "box_revolute") -> Path:
     return path
 
 
-def test_ids_follow_the_split_order_for_every_method(tmp_path, monkeypatch, capsys):
+def test_ids_follow_the_split_order_for_every_method(tmp_path, monkeypatch, capsys, load_script):
     rng = np.random.default_rng(3)
     test = [make_box_sample(rng, 64, instance_id=iid) for iid in (11, 11, 5, 8)]
     data = write_dataset(tmp_path / "data", {"test": test}, samples_per_shard=3)
     path = _run(tmp_path / "run.json", 4)
     monkeypatch.setattr("sys.argv", ["attach_instance_ids.py", str(path), "--data", str(data)])
-    _load().main()
+    load_script("attach_instance_ids").main()
     out = json.loads(path.read_text())["samples"]
     assert [(s["method"], s["error"], s["instance_id"]) for s in out] == [
         (m, i, iid) for m in ("capt", "capt_plain") for i, iid in enumerate((11, 11, 5, 8))]
     assert "3 instances" in capsys.readouterr().out
 
 
-def test_a_file_that_does_not_match_the_split_is_refused(tmp_path):
-    aid = _load()
+def test_a_file_that_does_not_match_the_split_is_refused(tmp_path, load_script):
+    aid = load_script("attach_instance_ids")
     with pytest.raises(ValueError, match="scored 3 clouds, the split holds 4"):
         aid.attach(json.loads(_run(tmp_path / "a.json", 3).read_text()), [1, 2, 3, 4], ["box_revolute"] * 4)
     with pytest.raises(ValueError, match="sample 0 is a laptop"):

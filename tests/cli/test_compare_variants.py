@@ -2,20 +2,10 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
 import pytest
-
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "compare_variants.py"
-
-
-def _load():
-    spec = importlib.util.spec_from_file_location("compare_variants", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def _write(path: Path, category: str, rows: dict) -> Path:
@@ -23,8 +13,8 @@ def _write(path: Path, category: str, rows: dict) -> Path:
     return path
 
 
-def test_means_over_joints_then_categories(tmp_path):
-    cv = _load()
+def test_means_over_joints_then_categories(tmp_path, load_script):
+    cv = load_script("compare_variants")
     a = _write(tmp_path / "a.json", "eyeglasses", {
         "capt": {"dir_med": [1.0, 3.0], "pos_aed": [0.02, 0.04], "state_med": [4.0, 6.0]},
         "capt_plain": {"dir_med": [2.0, 4.0], "pos_aed": [0.03, 0.05], "state_med": [5.0, 7.0]}})
@@ -47,8 +37,8 @@ def test_means_over_joints_then_categories(tmp_path):
     assert "| drawer_cabinet | capt | 6 | - | - | 0.03 |" in table
 
 
-def test_a_category_with_both_joint_types_and_an_all_prismatic_set(tmp_path):
-    cv = _load()
+def test_a_category_with_both_joint_types_and_an_all_prismatic_set(tmp_path, load_script):
+    cv = load_script("compare_variants")
     mixed = _write(tmp_path / "m.json", "kitchen", {
         "capt": {"dir_med": [2.0, 4.0], "pos_aed": [0.02, None], "state_med": [6.0, 0.1]}})
     row = cv.compare([mixed])["categories"]["kitchen"]["capt"]
@@ -59,10 +49,10 @@ def test_a_category_with_both_joint_types_and_an_all_prismatic_set(tmp_path):
     assert mean["pos_aed"] is None and mean["state_deg"] is None and mean["state_m"] == pytest.approx(0.03)
 
 
-def test_paired_gaps_from_per_sample_results(tmp_path):
+def test_paired_gaps_from_per_sample_results(tmp_path, load_script):
     """With the per-sample results of `capt evaluate --json`, the reference's gap to each method comes
     with a bootstrap interval, per category and over the mean; without them there is no such table."""
-    cv = _load()
+    cv = load_script("compare_variants")
     samples = []
     for i in range(30):
         for method, extra in (("capt", 0.0), ("capt_plain", 2.0)):
@@ -98,10 +88,10 @@ def _run_file(path: Path, offsets: dict[str, float], n: int = 30) -> Path:
     return path
 
 
-def test_two_training_runs_of_each_method_are_averaged(tmp_path):
+def test_two_training_runs_of_each_method_are_averaged(tmp_path, load_script):
     """Seed 0 has CAPT 1 deg worse on every cloud, seed 1 has it 3 deg better: the mean over runs is
     1 deg better, in the table and in the paired gap (whose per-cloud average makes it exact)."""
-    cv = _load()
+    cv = load_script("compare_variants")
     seed0 = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
     seed1 = _run_file(tmp_path / "seed1.json", {"capt": 0.0, "capt_plain": 3.0})
     result = cv.compare([seed0, seed1], draws=200, seed=0)
@@ -114,16 +104,16 @@ def test_two_training_runs_of_each_method_are_averaged(tmp_path):
     assert "| laptop | capt (mean of 2 runs) | 15 |" in cv.markdown(result)
 
 
-def test_runs_scored_on_different_clouds_are_refused(tmp_path):
-    cv = _load()
+def test_runs_scored_on_different_clouds_are_refused(tmp_path, load_script):
+    cv = load_script("compare_variants")
     seed0 = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0}, n=30)
     seed1 = _run_file(tmp_path / "seed1.json", {"capt": 0.0, "capt_plain": 3.0}, n=20)
     with pytest.raises(ValueError, match="laptop capt: its runs were scored on different clouds"):
         cv.compare([seed0, seed1], draws=10)
 
 
-def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys):
-    cv = _load()
+def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys, load_script):
+    cv = load_script("compare_variants")
     present = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
     monkeypatch.setattr("sys.argv", ["compare_variants.py", str(present), str(tmp_path / "nope.json")])
     with pytest.raises(SystemExit):
@@ -132,8 +122,8 @@ def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys):
     assert "no such capt evaluate --json file:" in err and "nope.json" in err and "seed0.json" not in err
 
 
-def test_an_input_given_twice_is_refused(tmp_path, monkeypatch, capsys):
-    cv = _load()
+def test_an_input_given_twice_is_refused(tmp_path, monkeypatch, capsys, load_script):
+    cv = load_script("compare_variants")
     run = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
     monkeypatch.setattr("sys.argv", ["compare_variants.py", str(run), str(tmp_path / "." / "seed0.json")])
     with pytest.raises(SystemExit):
@@ -141,8 +131,8 @@ def test_an_input_given_twice_is_refused(tmp_path, monkeypatch, capsys):
     assert "given twice" in capsys.readouterr().err
 
 
-def test_resampling_instances_needs_their_ids_and_says_so(tmp_path, monkeypatch, capsys):
-    cv = _load()
+def test_resampling_instances_needs_their_ids_and_says_so(tmp_path, monkeypatch, capsys, load_script):
+    cv = load_script("compare_variants")
     run = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
     monkeypatch.setattr("sys.argv", ["compare_variants.py", str(run), "--resample", "instances"])
     with pytest.raises(SystemExit):
