@@ -58,20 +58,29 @@ def category_errors(s: dict) -> dict[str, float | None]:
 
 
 def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed: int = 0,
-            resample: str = "clouds") -> dict:
+            resample: str = "clouds", only: list[str] | None = None) -> dict:
     """{"methods": [...], "categories": {cat: {method: {metric: value}}}, "mean": {method: {...}},
     "runs": {cat: {method: number of runs averaged}},
     "paired": {method: {cat or "mean": {metric: {difference, low, high, reference_lower_share}}}}}.
     ``paired`` is empty when ``draws`` is 0, when the files hold no per-sample results, or when the
-    reference method is not in them."""
+    reference method is not in them. ``only``: read just these methods from the files (e.g. leave
+    out a row one of several runs also scored); a listed method no file holds is a ValueError."""
     per_run: dict[str, dict[str, list[dict[str, float | None]]]] = {}
     samples: list[dict] = []
+    seen: set[str] = set()
     for index, path in enumerate(paths):
         run = json.loads(path.read_text())
-        samples.extend({**s, "run": index} for s in run.get("samples", []))
+        seen.update(run["summary"])
+        keep = (lambda m: True) if only is None else (lambda m: m in only)
+        samples.extend({**s, "run": index} for s in run.get("samples", []) if keep(s["method"]))
         for method, cats in run["summary"].items():
+            if not keep(method):
+                continue
             for cat, s in cats.items():
                 per_run.setdefault(cat, {}).setdefault(method, []).append(category_errors(s))
+    absent = sorted(set(only or ()) - seen)
+    if absent:
+        raise ValueError(f"no input scored the method(s) {absent}; they hold {sorted(seen)}")
     per_cat = {c: {m: {k: joint_mean([r[k] for r in runs]) for k, _ in METRICS} for m, runs in by_m.items()}
                for c, by_m in per_run.items()}
     methods = sorted(set.intersection(*(set(v) for v in per_cat.values())))
@@ -84,6 +93,7 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
         paired = {m: {c: {k: _as_dict(d) for k, d in by_metric.items()} for c, by_metric in rows.items()}
                   for m, rows in paired_differences(samples, reference, draws, seed, resample).items()}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths],
+            "only": only,
             "reference": reference, "draws": draws, "seed": seed, "resample": resample, "paired": paired,
             "runs": {c: {m: len(runs) for m, runs in by_m.items()} for c, by_m in per_run.items()}}
 
@@ -130,6 +140,8 @@ def main() -> None:
                         help="method whose gaps to the others are bootstrapped")
     parser.add_argument("--draws", type=int, default=2000, help="bootstrap draws (0: no paired gaps)")
     parser.add_argument("--seed", type=int, default=0, help="bootstrap seed")
+    parser.add_argument("--methods", nargs="+", default=None,
+                        help="read only these methods from the inputs (default: all)")
     parser.add_argument("--resample", choices=RESAMPLE_UNITS, default="clouds",
                         help="what a bootstrap draw resamples: test clouds, or test instances with all "
                              "their views (needs instance ids in the files)")
@@ -144,7 +156,7 @@ def main() -> None:
     if twice:
         parser.error(f"an input is given twice (it would count as two training runs): {', '.join(twice)}")
     try:
-        result = compare(args.inputs, args.reference, args.draws, args.seed, args.resample)
+        result = compare(args.inputs, args.reference, args.draws, args.seed, args.resample, args.methods)
     except ValueError as err:
         parser.error(str(err))
     table = markdown(result)

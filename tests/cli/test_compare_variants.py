@@ -148,3 +148,18 @@ def test_resampling_instances_needs_their_ids_and_says_so(tmp_path, monkeypatch,
     assert result["resample"] == "instances"
     assert result["paired"]["capt_plain"]["mean"]["dir_med"]["difference"] == pytest.approx(1.0)
     assert "interval over the test instances (every view of a drawn instance)" in cv.markdown(result)
+
+
+def test_methods_reads_only_the_listed_rows(tmp_path, load_script):
+    """A second run that also scored an ablation row: --methods leaves that row out; a method no
+    file holds is named."""
+    cv = load_script("compare_variants")
+    seed0 = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
+    seed1 = _run_file(tmp_path / "seed1.json", {"capt": 0.0, "capt_plain": 3.0, "capt_without_dv": 9.0})
+    everything = cv.compare([seed0, seed1], draws=0)
+    assert everything["runs"]["laptop"]["capt_without_dv"] == 1
+    result = cv.compare([seed0, seed1], draws=50, only=["capt", "capt_plain"])
+    assert result["methods"] == ["capt", "capt_plain"] and set(result["paired"]) == {"capt_plain"}
+    assert result["runs"] == {"laptop": {"capt": 2, "capt_plain": 2}}
+    with pytest.raises(ValueError, match=r"no input scored the method\(s\) \['pct_regression'\]"):
+        cv.compare([seed0], draws=0, only=["capt", "pct_regression"])
