@@ -9,9 +9,10 @@ then the mean over joint slots. The interval says how much the gap moves with th
 says nothing of training noise (another training seed can order two close methods the other way).
 
 What a draw resamples (``resample``): ``"clouds"`` draws clouds independently. A test split holds
-several views of each unseen instance, and views of one instance tend to be wrong together, so
+several views of each unseen instance, and views of one instance may be wrong together, so
 ``"instances"`` draws the instances with replacement and takes every cloud of a drawn instance (a
-cluster bootstrap): the interval is then over which objects are in the test split, usually wider.
+cluster bootstrap): the interval is then over which objects are in the test split, wider when the
+views of an instance agree (on this project's test splits it came out nearly the same).
 It needs every sample's ``instance_id`` (``capt evaluate --json`` records it;
 ``scripts/attach_instance_ids.py`` adds it to files written before it did).
 

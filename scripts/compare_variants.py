@@ -17,7 +17,8 @@ clouds (``perception/paired_comparison.py``; ``--draws``, ``--seed``): negative 
 has the lower error, and an interval that excludes 0 means the gap is more than the luck of which
 clouds are in the test split (it does not measure training noise). ``--resample instances`` draws
 the test instances instead, with all their views (needs the samples' ``instance_id``): the luck of
-which objects are in the test split.
+which objects are in the test split. ``--methods`` reads only the listed methods from the files
+(e.g. a seed's file that also scored ``capt_without_dv``).
 
     .venv/bin/python scripts/compare_variants.py benchmarks/perception_laptop.json \
         benchmarks/perception_oven.json --markdown benchmarks/variants_mean.md \
