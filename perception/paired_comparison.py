@@ -73,29 +73,28 @@ def error_matrix(samples: Sequence[Mapping], metric: str) -> np.ndarray:
     return out
 
 
+def _mean_over_joints(total: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """Per joint ``total / count`` where a joint has values, then the mean over those joints; NaN when
+    none has (``total``, ``count``: (..., joints))."""
+    has = count > 0
+    per_joint = np.where(has, total / np.maximum(count, 1), 0.0)
+    n = has.sum(axis=-1)
+    with np.errstate(invalid="ignore"):
+        return np.where(n > 0, per_joint.sum(axis=-1) / np.maximum(n, 1), np.nan)
+
+
 def table_value(errors: np.ndarray) -> np.ndarray:
     """The table's value of ``errors`` (..., clouds, joints): per joint the mean over clouds that have
     it, then the mean over joints that any cloud has; NaN when none has a value."""
     present = ~np.isnan(errors)
-    count = present.sum(axis=-2)
-    per_joint = np.where(present, errors, 0.0).sum(axis=-2) / np.maximum(count, 1)
-    has = count > 0
-    n = has.sum(axis=-1)
-    with np.errstate(invalid="ignore"):
-        return np.where(n > 0, np.where(has, per_joint, 0.0).sum(axis=-1) / np.maximum(n, 1), np.nan)
+    return _mean_over_joints(np.where(present, errors, 0.0).sum(axis=-2), present.sum(axis=-2))
 
 
 def weighted_table_value(errors: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """:func:`table_value` of ``errors`` (clouds, joints) with each cloud counted ``weights`` (draws,
-    clouds) times: one value per draw."""
+    clouds) times (whole numbers): one value per draw."""
     present = ~np.isnan(errors)
-    num = weights @ np.where(present, errors, 0.0)
-    count = weights @ present.astype(float)
-    has = count > 0
-    per_joint = np.where(has, num / np.maximum(count, 1e-300), 0.0)
-    n = has.sum(axis=-1)
-    with np.errstate(invalid="ignore"):
-        return np.where(n > 0, per_joint.sum(axis=-1) / np.maximum(n, 1), np.nan)
+    return _mean_over_joints(weights @ np.where(present, errors, 0.0), weights @ present.astype(float))
 
 
 def instance_draw_weights(instances: np.ndarray, draws: int, rng: np.random.Generator) -> np.ndarray:
@@ -162,7 +161,7 @@ def cloud_instances(groups: Mapping[tuple[str, str], Mapping[object, Sequence[Ma
     """The instance id of each cloud of ``category``, the same in every run of every method (they
     pair clouds by position); ValueError naming what is missing or differs."""
     found: np.ndarray | None = None
-    for (cat, method), runs in sorted(groups.items(), key=lambda kv: kv[0]):
+    for (cat, method), runs in sorted(groups.items()):
         if cat != category:
             continue
         for label, samples in runs.items():

@@ -22,30 +22,27 @@ from perception.data import load_split
 
 def attach(run: dict, instance_ids: list[int], categories: list[str]) -> dict:
     """A copy of ``run`` whose samples carry the instance id of the cloud they scored."""
-    by_method: dict[str, list[dict]] = {}
-    for sample in run.get("samples", []):
-        by_method.setdefault(sample["method"], []).append(sample)
-    if not by_method:
-        raise ValueError("the file holds no per-sample results")
-    for method, samples in by_method.items():
-        if len(samples) != len(instance_ids):
-            raise ValueError(f"{method} scored {len(samples)} clouds, the split holds {len(instance_ids)}")
-        for i, (sample, iid, cat) in enumerate(zip(samples, instance_ids, categories, strict=True)):
-            if sample["category"] != cat:
-                raise ValueError(f"{method} sample {i} is a {sample['category']}, "
-                                 f"the split's cloud {i} a {cat}")
-            if sample.get("instance_id") not in (None, iid):
-                raise ValueError(f"{method} sample {i} already has instance_id {sample['instance_id']}, "
-                                 f"the split's cloud {i} shows {iid}")
-    out = dict(run)
-    position: dict[str, int] = {}
+    scored: dict[str, int] = {}
     samples_out = []
-    for sample in run["samples"]:
-        i = position.get(sample["method"], 0)
-        position[sample["method"]] = i + 1
+    for sample in run.get("samples", []):
+        method = sample["method"]
+        i = scored.get(method, 0)
+        scored[method] = i + 1
+        if i >= len(instance_ids):
+            continue  # reported below with the method's count
+        if sample["category"] != categories[i]:
+            raise ValueError(f"{method} sample {i} is a {sample['category']}, "
+                             f"the split's cloud {i} a {categories[i]}")
+        if sample.get("instance_id") not in (None, instance_ids[i]):
+            raise ValueError(f"{method} sample {i} already has instance_id {sample['instance_id']}, "
+                             f"the split's cloud {i} shows {instance_ids[i]}")
         samples_out.append({**sample, "instance_id": instance_ids[i]})
-    out["samples"] = samples_out
-    return out
+    if not scored:
+        raise ValueError("the file holds no per-sample results")
+    for method, count in scored.items():
+        if count != len(instance_ids):
+            raise ValueError(f"{method} scored {count} clouds, the split holds {len(instance_ids)}")
+    return {**run, "samples": samples_out}
 
 
 def main() -> None:

@@ -69,10 +69,13 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     per_run: dict[str, dict[str, list[dict[str, float | None]]]] = {}
     samples: list[dict] = []
     seen: set[str] = set()
+
+    def keep(method: str) -> bool:
+        return only is None or method in only
+
     for index, path in enumerate(paths):
         run = json.loads(path.read_text())
         seen.update(run["summary"])
-        keep = (lambda m: True) if only is None else (lambda m: m in only)
         samples.extend({**s, "run": index} for s in run.get("samples", []) if keep(s["method"]))
         for method, cats in run["summary"].items():
             if not keep(method):
