@@ -63,8 +63,9 @@ def markdown(results: list[dict], group: str) -> str:
         for row in r["rows"]:
             if row["group"] != group:
                 continue
-            lines.append(f"| {r['checkpoint']} | {r['variant']} | {row['other']} | {row['mean_cosine']:+.3f} | "
-                         f"{row['negative_share']:.2f} | {row['summed_cosine']:+.3f} | {row['norm_ratio']:.3f} |")
+            lines.append(f"| {r['checkpoint']} | {r['variant']} | {row['other']} | "
+                         f"{row['mean_cosine']:+.3f} | {row['negative_share']:.2f} | "
+                         f"{row['summed_cosine']:+.3f} | {row['norm_ratio']:.3f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -76,13 +77,15 @@ def main() -> None:
     parser.add_argument("--split", default="val")
     parser.add_argument("--batches", type=int, default=25, help="batches per checkpoint (default 25)")
     parser.add_argument("--batch-size", type=int, default=8, help="as capt train (default 8)")
-    parser.add_argument("--motion-weight", type=float, default=0.1, help="W_motion (default 0.1, the paper's)")
+    parser.add_argument("--motion-weight", type=float, default=0.1,
+                        help="W_motion (default 0.1, the paper's)")
     parser.add_argument("--threads", type=int, default=None, help="torch threads (default: torch's)")
     parser.add_argument("--markdown", type=Path)
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
     if len(args.checkpoint) != len(args.data):
-        parser.error(f"{len(args.checkpoint)} --checkpoint but {len(args.data)} --data: give one --data each")
+        parser.error(f"{len(args.checkpoint)} --checkpoint but {len(args.data)} --data: "
+                     "give one --data each")
     if args.batches < 1 or args.batch_size < 1:
         parser.error("--batches and --batch-size must be at least 1")
     if args.motion_weight <= 0:
@@ -96,15 +99,15 @@ def main() -> None:
             results.append(measure(ckpt, data, args.split, args.batches, args.batch_size, args.motion_weight))
         except (CheckpointError, FileNotFoundError) as exc:
             raise SystemExit(f"error: {exc}") from None
+    command = " ".join([".venv/bin/python", "scripts/loss_gradient_alignment.py", *sys.argv[1:]])
     text = "\n".join(markdown(results, g) for g in ("shared", "articulation_shared"))
     print(text)
     if args.markdown:
         args.markdown.parent.mkdir(parents=True, exist_ok=True)
-        args.markdown.write_text(f"`python {' '.join(['scripts/loss_gradient_alignment.py', *sys.argv[1:]])}`\n\n"
-                                 + text)
+        args.markdown.write_text(f"`{command}`\n\n" + text)
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
-        payload = {"command": " ".join(["python", "scripts/loss_gradient_alignment.py", *sys.argv[1:]]),
+        payload = {"command": command,
                    "machine": machine_info(), "split": args.split, "batches": args.batches,
                    "batch_size": args.batch_size, "motion_weight": args.motion_weight, "results": results}
         args.json.write_text(json.dumps(payload, indent=2, allow_nan=True) + "\n")
