@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from dataclasses import asdict
 from pathlib import Path
@@ -52,6 +53,22 @@ def measure(checkpoint: Path, data: Path, split: str, batches: int, batch_size: 
             "variant": ckpt.config.model.variant, "rows": [asdict(r) for r in rows]}
 
 
+def _null_nan(value: object) -> object:
+    """NaN (not valid JSON) becomes null, recursively."""
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _null_nan(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_null_nan(v) for v in value]
+    return value
+
+
+def _fmt(value: float, spec: str) -> str:
+    """``value`` formatted, or "-" where it is undefined (a term that does not reach the group)."""
+    return "-" if math.isnan(value) else format(value, spec)
+
+
 def markdown(results: list[dict], group: str) -> str:
     """One line per checkpoint and term on ``group``."""
     lines = [f"State term against each other term, parameter group `{group}` "
@@ -64,8 +81,8 @@ def markdown(results: list[dict], group: str) -> str:
             if row["group"] != group:
                 continue
             lines.append(f"| {r['checkpoint']} | {r['variant']} | {row['other']} | "
-                         f"{row['mean_cosine']:+.3f} | {row['negative_share']:.2f} | "
-                         f"{row['summed_cosine']:+.3f} | {row['norm_ratio']:.3f} |")
+                         f"{_fmt(row['mean_cosine'], '+.3f')} | {_fmt(row['negative_share'], '.2f')} | "
+                         f"{_fmt(row['summed_cosine'], '+.3f')} | {row['norm_ratio']:.3f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -110,7 +127,7 @@ def main() -> None:
         payload = {"command": command,
                    "machine": machine_info(), "split": args.split, "batches": args.batches,
                    "batch_size": args.batch_size, "motion_weight": args.motion_weight, "results": results}
-        args.json.write_text(json.dumps(payload, indent=2, allow_nan=True) + "\n")
+        args.json.write_text(json.dumps(_null_nan(payload), indent=2, allow_nan=False) + "\n")
 
 
 if __name__ == "__main__":

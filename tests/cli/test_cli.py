@@ -162,6 +162,22 @@ def test_train_config_takes_the_command_line_overrides(tmp_path: Path) -> None:
         train_config_for("configs/perception/capt.yaml", str(data), None, None, -1)
 
 
+def test_capt_without_motion_loss_differs_from_capt_in_the_motion_weight_only(tmp_path: Path) -> None:
+    from capt_env.commands.train import train_config_for
+
+    data = tmp_path / "data"
+    data.mkdir()
+    (data / "manifest.json").write_text(json.dumps({"config": {"category": "washing_machine"}}))
+    capt, _ = train_config_for("configs/perception/capt.yaml", str(data), None, None)
+    ablation, _ = train_config_for("configs/perception/capt_without_motion_loss.yaml", str(data), None, None)
+    # the same model config, so a run can --init-from a CAPT checkpoint and fork
+    assert ablation.model.model == capt.model.model and ablation.model.model.variant == "capt"
+    assert ablation.model.effective_loss_weights().motion == 0.0
+    assert capt.model.effective_loss_weights().motion == 0.1
+    assert ablation.model.voting == capt.model.voting
+    assert (ablation.epochs, ablation.lr, ablation.batch_size) == (capt.epochs, capt.lr, capt.batch_size)
+
+
 def test_evaluate_names_bad_input_without_a_traceback(tmp_path: Path) -> None:
     shipped = str(Path(__file__).resolve().parents[2] / "perception" / "checkpoints" / "oven.pt")
     with pytest.raises(SystemExit, match="capt evaluate: a checkpoint is given twice"):
