@@ -13,7 +13,7 @@ lead, not a finding.
     .venv/bin/python scripts/gap_by_true_state.py \
         benchmarks/perception_washing_machine_voting_ablation_seed{0,1,2}.json \
         --data data/washing_machine --reference capt_without_dv --methods capt_without_dv capt_plain \
-        --edges 0 25 45 70 105 --markdown benchmarks/state_gap_by_true_state_wm.md
+        --edges 0 25 45 70 105 --markdown benchmarks/state_gap_by_true_state_washing_machine.md
 """
 
 from __future__ import annotations
