@@ -67,16 +67,17 @@ def term_gradients(model: CaptModel, batch: Mapping[str, torch.Tensor], config: 
     model.eval()
     out = model(batch["points"])
     losses = capt_losses(out, dict(batch), scoring)
-    groups = {g: group_parameters(model, g) for g in PARAMETER_GROUPS}
+    encoder, art_shared = group_parameters(model, "encoder"), group_parameters(model, "articulation_shared")
+    params = encoder + art_shared
     result: dict[str, dict[str, torch.Tensor]] = {}
     for term in terms:
         weighted = getattr(weights, term) * losses[term]
-        result[term] = {}
-        for g, params in groups.items():
-            grads = torch.autograd.grad(weighted, params, retain_graph=True, allow_unused=True)
-            result[term][g] = torch.cat([
-                (torch.zeros_like(p) if gr is None else gr).reshape(-1) for gr, p in zip(grads, params,
-                                                                                         strict=True)])
+        grads = torch.autograd.grad(weighted, params, retain_graph=True, allow_unused=True)
+        flat = [(torch.zeros_like(p) if g is None else g).reshape(-1)
+                for g, p in zip(grads, params, strict=True)]
+        result[term] = {"encoder": torch.cat(flat[:len(encoder)]),
+                        "articulation_shared": torch.cat(flat[len(encoder):]),
+                        "shared": torch.cat(flat)}
     return result
 
 
