@@ -23,11 +23,12 @@ import json
 import math
 import sys
 from collections.abc import Sequence
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
-from capt_env.commands.json_output import machine_info
+from capt_env.commands.json_output import write_json
 from perception.data import load_split
 from perception.paired_comparison import METRICS, RESAMPLE_UNITS, paired_differences
 
@@ -129,17 +130,11 @@ def main() -> None:
     if args.markdown:
         args.markdown.parent.mkdir(parents=True, exist_ok=True)
         args.markdown.write_text(f"`{command}`\n\n{text}")
-    if args.json:
-        payload = {"command": command, "machine": machine_info(), "inputs": [str(p) for p in args.inputs],
-                   "reference": args.reference, "edges": args.edges, "unit": unit, "counts": counts,
-                   "resample": args.resample, "draws": args.draws, "seed": args.seed,
-                   "gaps": {o: {b: {m: (None if d is None else {"difference": d.difference, "low": d.low,
-                                                                "high": d.high})
-                                    for m, d in r.items()} for b, r in rows.items() if b != "mean"}
-                            for o, rows in gaps.items()}}
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(payload, indent=2) + "\n")
-
+    write_json(args.json, {
+        "inputs": [str(p) for p in args.inputs], "reference": args.reference, "edges": args.edges,
+        "unit": unit, "counts": counts, "resample": args.resample, "draws": args.draws, "seed": args.seed,
+        "gaps": {o: {b: {m: None if d is None else asdict(d) for m, d in r.items()}
+                     for b, r in rows.items() if b != "mean"} for o, rows in gaps.items()}}, command)
 
 if __name__ == "__main__":
     main()

@@ -15,7 +15,6 @@ checkpoint, also on CAPT-plain ones that trained without it.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from dataclasses import asdict
@@ -25,7 +24,7 @@ import torch
 from torch.utils.data import DataLoader
 from tqdm import tqdm
 
-from capt_env.commands.json_output import machine_info
+from capt_env.commands.json_output import write_json
 from perception.checkpoint import CheckpointError, build_model, load_checkpoint
 from perception.data import CaptShardDataset
 from perception.gradient_alignment import LOSS_TERMS, PARAMETER_GROUPS, alignments, term_gradients
@@ -51,17 +50,6 @@ def measure(checkpoint: Path, data: Path, split: str, batches: int, batch_size: 
     rows = alignments(per_batch, REFERENCE, OTHERS, PARAMETER_GROUPS)
     return {"checkpoint": str(checkpoint), "data": str(data), "category": ckpt.category,
             "variant": ckpt.config.model.variant, "rows": [asdict(r) for r in rows]}
-
-
-def _null_nan(value: object) -> object:
-    """NaN (not valid JSON) becomes null, recursively."""
-    if isinstance(value, float) and math.isnan(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _null_nan(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_null_nan(v) for v in value]
-    return value
 
 
 def _fmt(value: float, spec: str) -> str:
@@ -122,13 +110,8 @@ def main() -> None:
     if args.markdown:
         args.markdown.parent.mkdir(parents=True, exist_ok=True)
         args.markdown.write_text(f"`{command}`\n\n" + text)
-    if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        payload = {"command": command,
-                   "machine": machine_info(), "split": args.split, "batches": args.batches,
-                   "batch_size": args.batch_size, "motion_weight": args.motion_weight, "results": results}
-        args.json.write_text(json.dumps(_null_nan(payload), indent=2, allow_nan=False) + "\n")
-
+    write_json(args.json, {"split": args.split, "batches": args.batches, "batch_size": args.batch_size,
+                           "motion_weight": args.motion_weight, "results": results}, command)
 
 if __name__ == "__main__":
     main()

@@ -39,13 +39,16 @@ def _strict(value: Any) -> Any:
     return value
 
 
-def write_json(path: str | os.PathLike | None, payload: dict[str, Any]) -> None:
-    """Write ``payload`` plus ``machine`` to ``path`` as strict JSON (NaN -> null; no-op for None)."""
+def write_json(path: str | os.PathLike | None, payload: dict[str, Any], command: str | None = None) -> None:
+    """Write ``payload`` plus ``command`` and ``machine`` to ``path`` as strict JSON (NaN -> null; no-op
+    for None). ``command`` defaults to the running ``capt`` command line (scripts pass their own)."""
     if path is None:
         return
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    data = {"command": " ".join(["capt", *sys.argv[1:]]), "machine": machine_info(), **payload}
+    if command is None:
+        command = " ".join(["capt", *sys.argv[1:]])
+    data = {"command": command, "machine": machine_info(), **payload}
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
     with os.fdopen(fd, "w") as fh:
         json.dump(_strict(json.loads(json.dumps(data, default=float))), fh, indent=2, allow_nan=False)
