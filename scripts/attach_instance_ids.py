@@ -15,8 +15,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
+from capt_env.commands.json_output import write_json
 from perception.data import load_split
 
 
@@ -61,7 +63,10 @@ def main() -> None:
     except (ValueError, FileNotFoundError) as err:
         parser.error(f"{args.input}: {err}")
     out = args.out or args.input
-    out.write_text(json.dumps(result, indent=2) + "\n")
+    # keeps the evaluation's own command and machine (those of this script if the file had none)
+    command = result.get("command") or " ".join([".venv/bin/python", "scripts/attach_instance_ids.py",
+                                                 *sys.argv[1:]])
+    write_json(out, result, command)
     ids = sorted({s["instance_id"] for s in result["samples"]})
     print(f"wrote {out}: {len(result['samples'])} samples, {len(ids)} instances of the {split} split")
 

@@ -30,8 +30,10 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
+import sys
 from pathlib import Path
 
+from capt_env.commands.json_output import write_json
 from perception.paired_comparison import METRICS as PAIRED_METRICS
 from perception.paired_comparison import RESAMPLE_UNITS, PairedDifference, paired_differences
 
@@ -165,10 +167,11 @@ def main() -> None:
         parser.error(str(err))
     table = markdown(result)
     print(table, end="")
+    command = " ".join([".venv/bin/python", "scripts/compare_variants.py", *sys.argv[1:]])
     if args.markdown:
-        args.markdown.write_text(table)
-    if args.json:
-        args.json.write_text(json.dumps(result, indent=2) + "\n")
+        args.markdown.parent.mkdir(parents=True, exist_ok=True)
+        args.markdown.write_text(f"`{command}`\n\n{table}")
+    write_json(args.json, result, command)
 
 
 if __name__ == "__main__":

@@ -32,6 +32,24 @@ def test_ids_follow_the_split_order_for_every_method(tmp_path, monkeypatch, caps
     assert "3 instances" in capsys.readouterr().out
 
 
+def test_the_evaluations_own_command_and_machine_are_kept(tmp_path, monkeypatch, load_script):
+    rng = np.random.default_rng(4)
+    data = write_dataset(tmp_path / "data", {"test": [make_box_sample(rng, 64, instance_id=2)]},
+                         samples_per_shard=1)
+    path = _run(tmp_path / "run.json", 1)
+    run = json.loads(path.read_text())
+    run.update(command="capt evaluate a.pt --data d", machine={"cpu_count": 7})
+    path.write_text(json.dumps(run))
+    out = tmp_path / "with_ids.json"
+    monkeypatch.setattr("sys.argv", ["attach_instance_ids.py", str(path), "--data", str(data),
+                                     "--out", str(out)])
+    load_script("attach_instance_ids").main()
+    written = json.loads(out.read_text())
+    assert written["command"] == "capt evaluate a.pt --data d" and written["machine"] == {"cpu_count": 7}
+    assert [s["instance_id"] for s in written["samples"]] == [2, 2]
+    assert not list(tmp_path.glob("*.tmp"))  # written atomically, nothing left behind
+
+
 def test_a_file_that_does_not_match_the_split_is_refused(tmp_path, load_script):
     aid = load_script("attach_instance_ids")
     with pytest.raises(ValueError, match="scored 3 clouds, the split holds 4"):

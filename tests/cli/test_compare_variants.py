@@ -163,3 +163,19 @@ def test_methods_reads_only_the_listed_rows(tmp_path, load_script):
     assert result["runs"] == {"laptop": {"capt": 2, "capt_plain": 2}}
     with pytest.raises(ValueError, match=r"no input scored the method\(s\) \['pct_regression'\]"):
         cv.compare([seed0], draws=0, only=["capt", "pct_regression"])
+
+
+def test_main_writes_markdown_and_json_with_its_command(tmp_path, monkeypatch, load_script):
+    cv = load_script("compare_variants")
+    a = _write(tmp_path / "a.json", "oven", {
+        "capt": {"dir_med": [1.0], "pos_aed": [0.02], "state_med": [4.0]},
+        "capt_plain": {"dir_med": [2.0], "pos_aed": [0.03], "state_med": [5.0]}})
+    md, js = tmp_path / "out" / "cmp.md", tmp_path / "out" / "cmp.json"
+    monkeypatch.setattr("sys.argv", ["compare_variants.py", str(a), "--draws", "0", "--markdown", str(md),
+                                     "--json", str(js)])
+    cv.main()
+    command = f".venv/bin/python scripts/compare_variants.py {a} --draws 0 --markdown {md} --json {js}"
+    assert md.read_text().startswith(f"`{command}`\n\n| category | method |")
+    written = json.loads(js.read_text())
+    assert written["command"] == command and "cpu_count" in written["machine"]
+    assert written["categories"]["oven"]["capt_plain"]["dir_med"] == pytest.approx(2.0)
