@@ -68,7 +68,7 @@ def main() -> None:
                                                  *sys.argv[1:]])
     write_json(out, result, command)
     ids = sorted({s["instance_id"] for s in result["samples"]})
-    print(f"wrote {out}: {len(result['samples'])} samples, {len(ids)} instances of the {split} split")
+    print(f"{len(result['samples'])} samples, {len(ids)} instances of the {split} split")
 
 
 if __name__ == "__main__":
