@@ -11,6 +11,8 @@ from __future__ import annotations
 import torch
 from torch import nn
 
+from perception.pointwise import PointwiseConv1d, PointwiseConv2d
+
 
 def knn_indices(xyz: torch.Tensor, k: int) -> torch.Tensor:
     """Indices (B, n, k) of each point's k nearest neighbours (itself included) in ``xyz`` (B, n, 3)."""
@@ -33,7 +35,8 @@ class NeighbourEmbedding(nn.Module):
     def __init__(self, channels: int) -> None:
         super().__init__()
         self.mlp = nn.Sequential(
-            nn.Conv2d(2 * channels, channels, 1, bias=False), nn.BatchNorm2d(channels), nn.ReLU(inplace=True)
+            PointwiseConv2d(2 * channels, channels, bias=False), nn.BatchNorm2d(channels),
+            nn.ReLU(inplace=True),
         )
 
     def forward(self, feat: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
@@ -48,9 +51,9 @@ class OffsetAttention(nn.Module):
 
     def __init__(self, channels: int) -> None:
         super().__init__()
-        self.qk = nn.Conv1d(channels, channels // 4, 1, bias=False)
-        self.v = nn.Conv1d(channels, channels, 1)
-        self.trans = nn.Conv1d(channels, channels, 1)
+        self.qk = PointwiseConv1d(channels, channels // 4, bias=False)
+        self.v = PointwiseConv1d(channels, channels)
+        self.trans = PointwiseConv1d(channels, channels)
         self.norm = nn.BatchNorm1d(channels)
         self.act = nn.ReLU(inplace=True)
 
@@ -71,12 +74,12 @@ class PCTEncoder(nn.Module):
         d = embed_dim
         self.knn_k = knn_k
         self.input_embedding = nn.Sequential(
-            nn.Conv1d(3, d, 1, bias=False), nn.BatchNorm1d(d), nn.ReLU(inplace=True),
-            nn.Conv1d(d, d, 1, bias=False), nn.BatchNorm1d(d), nn.ReLU(inplace=True),
+            PointwiseConv1d(3, d, bias=False), nn.BatchNorm1d(d), nn.ReLU(inplace=True),
+            PointwiseConv1d(d, d, bias=False), nn.BatchNorm1d(d), nn.ReLU(inplace=True),
         )
         self.neighbour = nn.ModuleList(NeighbourEmbedding(d) for _ in range(neighbor_layers))
         self.attention = nn.ModuleList(OffsetAttention(d) for _ in range(4))
-        self.fuse = nn.Sequential(nn.Conv1d(4 * d, 4 * d, 1, bias=False), nn.BatchNorm1d(4 * d),
+        self.fuse = nn.Sequential(PointwiseConv1d(4 * d, 4 * d, bias=False), nn.BatchNorm1d(4 * d),
                                   nn.LeakyReLU(0.2, inplace=True))
         self.point_dim = 4 * d
         self.global_dim = 8 * d

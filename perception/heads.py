@@ -11,18 +11,20 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from perception.pointwise import PointwiseConv1d
+
 
 def _pointwise_mlp(in_dim: int, hidden: int, out_dim: int, dropout: float) -> nn.Sequential:
     return nn.Sequential(
-        nn.Conv1d(in_dim, hidden, 1, bias=False), nn.BatchNorm1d(hidden), nn.ReLU(inplace=True),
+        PointwiseConv1d(in_dim, hidden, bias=False), nn.BatchNorm1d(hidden), nn.ReLU(inplace=True),
         nn.Dropout(dropout),
-        nn.Conv1d(hidden, hidden // 2, 1, bias=False), nn.BatchNorm1d(hidden // 2), nn.ReLU(inplace=True),
-        nn.Conv1d(hidden // 2, out_dim, 1),
+        PointwiseConv1d(hidden, hidden // 2, bias=False), nn.BatchNorm1d(hidden // 2), nn.ReLU(inplace=True),
+        PointwiseConv1d(hidden // 2, out_dim),
     )
 
 
 def _with_global(per_point: torch.Tensor, global_feat: torch.Tensor) -> torch.Tensor:
-    """(B, n, C) and (B, G) -> (B, C+G, n) for Conv1d heads."""
+    """(B, n, C) and (B, G) -> (B, C+G, n) for the pointwise heads."""
     n = per_point.shape[1]
     return torch.cat([per_point.transpose(1, 2), global_feat.unsqueeze(-1).expand(-1, -1, n)], dim=1)
 
