@@ -3,9 +3,10 @@
 ``PointwiseConv1d`` / ``PointwiseConv2d`` are ``nn.Conv1d`` / ``nn.Conv2d`` with kernel size 1: the same
 parameters, the same ``state_dict`` keys and shapes (so checkpoints load either way), the same outputs up
 to float rounding. Only ``forward`` differs: one matrix product over the channel dim instead of a
-convolution call. On this project's 2-core CPU that made the shipped model's forward pass about 20%
-faster (38.5 -> 30.6 ms for the laptop, session 29), because oneDNN's 1x1 convolution is slower there
-than the equivalent GEMM.
+convolution call, which oneDNN runs more slowly than the equivalent GEMM on this project's 2-core CPU.
+The gain is small: interleaved A/B on the four shipped models (``scripts/pointwise_ab_timing.py``,
+session 29) made the forward pass 0.3-2.5 ms faster (24-33 ms), within the machine's noise for a
+whole ``predict`` call.
 """
 
 from __future__ import annotations
