@@ -15,10 +15,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 
-from capt_env.commands.json_output import write_json
+from capt_env.commands.json_output import script_command, write_json
 from perception.data import load_split
 
 
@@ -64,9 +63,7 @@ def main() -> None:
         parser.error(f"{args.input}: {err}")
     out = args.out or args.input
     # keeps the evaluation's own command and machine (those of this script if the file had none)
-    command = result.get("command") or " ".join([".venv/bin/python", "scripts/attach_instance_ids.py",
-                                                 *sys.argv[1:]])
-    write_json(out, result, command)
+    write_json(out, result, result.get("command") or script_command())
     ids = sorted({s["instance_id"] for s in result["samples"]})
     print(f"{len(result['samples'])} samples, {len(ids)} instances of the {split} split")
 

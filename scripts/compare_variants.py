@@ -30,10 +30,9 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
-import sys
 from pathlib import Path
 
-from capt_env.commands.json_output import write_json
+from capt_env.commands.json_output import script_command, write_json, write_markdown
 from perception.paired_comparison import METRICS as PAIRED_METRICS
 from perception.paired_comparison import RESAMPLE_UNITS, PairedDifference, paired_differences
 
@@ -167,10 +166,8 @@ def main() -> None:
         parser.error(str(err))
     table = markdown(result)
     print(table, end="")
-    command = " ".join([".venv/bin/python", "scripts/compare_variants.py", *sys.argv[1:]])
-    if args.markdown:
-        args.markdown.parent.mkdir(parents=True, exist_ok=True)
-        args.markdown.write_text(f"`{command}`\n\n{table}")
+    command = script_command()
+    write_markdown(args.markdown, table, command)
     write_json(args.json, result, command)
 
 

@@ -21,14 +21,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import sys
 from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
-from capt_env.commands.json_output import write_json
+from capt_env.commands.json_output import script_command, write_json, write_markdown
 from perception.data import load_split
 from perception.paired_comparison import METRICS, RESAMPLE_UNITS, paired_differences
 
@@ -126,15 +125,14 @@ def main() -> None:
             lines.append(f"| {b} | {counts[b]} | {args.reference} - {other} | " + " | ".join(cells) + " |")
     text = "\n".join(lines) + "\n"
     print(text)
-    command = " ".join([".venv/bin/python", "scripts/gap_by_true_state.py", *sys.argv[1:]])
-    if args.markdown:
-        args.markdown.parent.mkdir(parents=True, exist_ok=True)
-        args.markdown.write_text(f"`{command}`\n\n{text}")
+    command = script_command()
+    write_markdown(args.markdown, text, command)
     write_json(args.json, {
         "inputs": [str(p) for p in args.inputs], "reference": args.reference, "edges": args.edges,
         "unit": unit, "counts": counts, "resample": args.resample, "draws": args.draws, "seed": args.seed,
         "gaps": {o: {b: {m: None if d is None else asdict(d) for m, d in r.items()}
                      for b, r in rows.items() if b != "mean"} for o, rows in gaps.items()}}, command)
+
 
 if __name__ == "__main__":
     main()

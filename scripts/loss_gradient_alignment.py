@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from dataclasses import asdict
 from pathlib import Path
 
@@ -24,7 +23,7 @@ import torch
 from torch.utils.data import DataLoader
 from tqdm import tqdm
 
-from capt_env.commands.json_output import write_json
+from capt_env.commands.json_output import script_command, write_json, write_markdown
 from perception.checkpoint import CheckpointError, build_model, load_checkpoint
 from perception.data import CaptShardDataset
 from perception.gradient_alignment import LOSS_TERMS, PARAMETER_GROUPS, alignments, term_gradients
@@ -104,14 +103,13 @@ def main() -> None:
             results.append(measure(ckpt, data, args.split, args.batches, args.batch_size, args.motion_weight))
         except (CheckpointError, FileNotFoundError) as exc:
             raise SystemExit(f"error: {exc}") from None
-    command = " ".join([".venv/bin/python", "scripts/loss_gradient_alignment.py", *sys.argv[1:]])
+    command = script_command()
     text = "\n".join(markdown(results, g) for g in ("shared", "articulation_shared"))
     print(text)
-    if args.markdown:
-        args.markdown.parent.mkdir(parents=True, exist_ok=True)
-        args.markdown.write_text(f"`{command}`\n\n" + text)
+    write_markdown(args.markdown, text, command)
     write_json(args.json, {"split": args.split, "batches": args.batches, "batch_size": args.batch_size,
                            "motion_weight": args.motion_weight, "results": results}, command)
+
 
 if __name__ == "__main__":
     main()

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
 from pathlib import Path
 
@@ -21,7 +20,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from capt_env.commands.json_output import write_json
+from capt_env.commands.json_output import script_command, write_json
 from perception import pointwise
 from perception.checkpoints import default_checkpoint
 from perception.data import CaptShardDataset
@@ -37,6 +36,8 @@ def use_matmul(matmul: bool) -> None:
 
 
 def time_category(category: str, data_root: Path, clouds: int, rounds: int) -> dict[str, float | int]:
+    """Median ``predict`` latency and forward-pass time (ms) of the shipped ``category`` model, matrix
+    product vs convolution, interleaved over ``rounds`` on the first ``clouds`` test clouds."""
     est = ArticulationEstimator.from_checkpoint(default_checkpoint(category))
     ds = CaptShardDataset(data_root / category, "test", est.config.model, augment=False, max_samples=clouds)
     pts = []
@@ -84,8 +85,7 @@ def main() -> None:
         print(f"{cat}: predict {r['predict_ms_matmul']:.1f} ms (matmul) vs {r['predict_ms_conv']:.1f} ms "
               f"(conv); forward {r['forward_ms_matmul']:.1f} vs {r['forward_ms_conv']:.1f} ms; "
               f"{r['calls_each']} calls each")
-    command = " ".join([".venv/bin/python", "scripts/pointwise_ab_timing.py", *sys.argv[1:]])
-    write_json(args.json, {"threads": torch.get_num_threads(), "results": results}, command)
+    write_json(args.json, {"threads": torch.get_num_threads(), "results": results}, script_command())
 
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
-"""Write a command's numbers as JSON (atomically), with the machine and versions that produced them."""
+"""Write a command's numbers as JSON (atomically), with the machine and versions that produced them, and
+its Markdown table headed by the command line."""
 
 from __future__ import annotations
 
@@ -55,3 +56,17 @@ def write_json(path: str | os.PathLike | None, payload: dict[str, Any], command:
         fh.write("\n")
     os.replace(tmp, path)
     print(f"wrote {path}")
+
+
+def script_command() -> str:
+    """The running repository script's command line, as ``.venv/bin/python scripts/<name>.py ARGS``."""
+    return " ".join([".venv/bin/python", f"scripts/{Path(sys.argv[0]).name}", *sys.argv[1:]])
+
+
+def write_markdown(path: str | os.PathLike | None, text: str, command: str) -> None:
+    """Write ``text`` to ``path`` headed by ``command`` in backticks (no-op for None)."""
+    if path is None:
+        return
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(f"`{command}`\n\n{text}")
