@@ -15,9 +15,13 @@ from perception.pointwise import PointwiseConv1d, PointwiseConv2d
 
 
 def knn_indices(xyz: torch.Tensor, k: int) -> torch.Tensor:
-    """Indices (B, n, k) of each point's k nearest neighbours (itself included) in ``xyz`` (B, n, 3)."""
-    d2 = torch.cdist(xyz, xyz)
-    return d2.topk(k, dim=-1, largest=False).indices
+    """Indices (B, n, k) of each point's k nearest neighbours (itself included) in ``xyz`` (B, n, 3).
+
+    Ranks row i by |x_j|^2 - 2 x_i . x_j, the squared distance less the row's constant |x_i|^2: one
+    batched product, no square root."""
+    sq = xyz.square().sum(dim=-1).unsqueeze(1)  # (B, 1, n)
+    score = torch.baddbmm(sq, xyz, xyz.transpose(1, 2), alpha=-2.0)
+    return score.topk(k, dim=-1, largest=False).indices
 
 
 def gather_neighbours(feat: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
@@ -30,7 +34,12 @@ def gather_neighbours(feat: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
 
 class NeighbourEmbedding(nn.Module):
     """One SG-style layer without sampling: edge features (f_j - f_i, f_i) of the k neighbours -> LBR
-    -> max over the neighbourhood."""
+    -> max over the neighbourhood.
+
+    The linear map W = [W_e, W_c] of the edge feature is applied before the neighbours are gathered:
+    W (f_j - f_i, f_i) = (W_e f)_j + ((W_c - W_e) f)_i, so the products run over the n points rather
+    than the n * k edges (k times fewer; the same result up to float rounding, the same parameters).
+    """
 
     def __init__(self, channels: int) -> None:
         super().__init__()
@@ -40,9 +49,13 @@ class NeighbourEmbedding(nn.Module):
         )
 
     def forward(self, feat: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
-        neigh = gather_neighbours(feat, idx)
-        centre = feat.unsqueeze(-1).expand_as(neigh)
-        return self.mlp(torch.cat([neigh - centre, centre], dim=1)).amax(dim=-1)
+        linear, norm, act = self.mlp
+        c = feat.shape[1]
+        w = linear.weight[:, :, 0, 0]
+        w_edge, w_centre = w[:, :c], w[:, c:]
+        edge = gather_neighbours(torch.matmul(w_edge, feat), idx)  # (B, C_out, n, k)
+        centre = torch.matmul(w_centre - w_edge, feat).unsqueeze(-1)  # (B, C_out, n, 1)
+        return act(norm(edge + centre)).amax(dim=-1)
 
 
 class OffsetAttention(nn.Module):

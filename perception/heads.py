@@ -23,10 +23,22 @@ def _pointwise_mlp(in_dim: int, hidden: int, out_dim: int, dropout: float) -> nn
     )
 
 
-def _with_global(per_point: torch.Tensor, global_feat: torch.Tensor) -> torch.Tensor:
-    """(B, n, C) and (B, G) -> (B, C+G, n) for the pointwise heads."""
-    n = per_point.shape[1]
-    return torch.cat([per_point.transpose(1, 2), global_feat.unsqueeze(-1).expand(-1, -1, n)], dim=1)
+def _run_with_global(mlp: nn.Sequential, per_point: torch.Tensor, global_feat: torch.Tensor) -> torch.Tensor:
+    """``mlp`` applied to [per_point, global_feat broadcast to every point]: (B, n, C), (B, G) -> (B, out, n).
+
+    The first layer's W = [W_p, W_g] is split so the global term W_g g is computed once per cloud and
+    added to W_p p at every point, instead of multiplying the broadcast (G, n) copy (G = 2C, so two
+    thirds of that layer's products); the same result up to float rounding, the same parameters.
+    """
+    first, *rest = mlp
+    w = first.weight[:, :, 0]
+    c = per_point.shape[-1]
+    y = torch.matmul(w[:, :c], per_point.transpose(1, 2)) + torch.matmul(w[:, c:], global_feat.unsqueeze(-1))
+    if first.bias is not None:
+        y = y + first.bias[:, None]
+    for layer in rest:
+        y = layer(y)
+    return y
 
 
 class SegmentationHead(nn.Module):
@@ -37,7 +49,7 @@ class SegmentationHead(nn.Module):
         self.mlp = _pointwise_mlp(in_dim, hidden, num_parts, dropout)
 
     def forward(self, per_point: torch.Tensor, global_feat: torch.Tensor) -> torch.Tensor:
-        return self.mlp(_with_global(per_point, global_feat)).transpose(1, 2)
+        return _run_with_global(self.mlp, per_point, global_feat).transpose(1, 2)
 
 
 class ArticulationHead(nn.Module):
@@ -52,7 +64,7 @@ class ArticulationHead(nn.Module):
 
     def forward(self, per_point: torch.Tensor, global_feat: torch.Tensor
                 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-        raw = self.mlp(_with_global(per_point, global_feat)).transpose(1, 2)
+        raw = _run_with_global(self.mlp, per_point, global_feat).transpose(1, 2)
         raw = raw.reshape(*raw.shape[:2], self.num_joints, 8)
         direction = F.normalize(raw[..., 0:3], dim=-1, eps=1e-6)
         dist = F.softplus(raw[..., 3])

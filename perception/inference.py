@@ -82,13 +82,27 @@ def resample_indices(num_in: int, num_out: int, seed: int) -> np.ndarray:
 
 def nearest_labels(query: np.ndarray, ref: np.ndarray, ref_labels: np.ndarray,
                    chunk: int = 4096) -> np.ndarray:
-    """Label of the nearest ``ref`` point for each ``query`` point (Euclidean)."""
+    """Label of the nearest ``ref`` point for each ``query`` point (Euclidean), ranking the refs by
+    |r|^2 - 2 q . r (the squared distance less the query's constant |q|^2)."""
     ref_t = torch.as_tensor(ref, dtype=torch.float32)
+    ref_sq = ref_t.square().sum(dim=1)
     out = np.empty(len(query), dtype=np.int64)
     for s in range(0, len(query), chunk):
         q = torch.as_tensor(query[s:s + chunk], dtype=torch.float32)
-        out[s:s + chunk] = ref_labels[torch.cdist(q, ref_t).argmin(dim=1).numpy()]
+        out[s:s + chunk] = ref_labels[torch.addmm(ref_sq, q, ref_t.T, alpha=-2.0).argmin(dim=1).numpy()]
     return out
+
+
+def labels_for_all_points(points: np.ndarray, fed: np.ndarray, fed_labels: np.ndarray) -> np.ndarray:
+    """Part labels (N,) for every point of ``points`` (N, 3): the network's own label where the point was
+    fed (indices ``fed``), the label of the nearest fed point elsewhere."""
+    labels = np.empty(len(points), dtype=np.int64)
+    labels[fed] = fed_labels
+    rest = np.ones(len(points), dtype=bool)
+    rest[fed] = False
+    if rest.any():
+        labels[rest] = nearest_labels(points[rest], points[fed], fed_labels)
+    return labels
 
 
 class ArticulationEstimator:
@@ -152,7 +166,7 @@ class ArticulationEstimator:
         cfg = self.config.model
         if out.seg_logits is not None:
             kept_labels = out.seg_logits[b].argmax(dim=-1).cpu().numpy().astype(np.int64)
-            labels = nearest_labels(points, points[idx], kept_labels)
+            labels = labels_for_all_points(points, idx, kept_labels)
         else:
             kept_labels = None
             labels = np.full(len(points), -1, dtype=np.int64)
