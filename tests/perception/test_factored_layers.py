@@ -103,3 +103,17 @@ def test_the_ab_script_switches_forms_and_restores_the_factored_ones(ab):
         ab.use_factored(True)
     assert encoder.knn_indices is knn_indices and heads._run_with_global is _run_with_global
     assert NeighbourEmbedding.forward is ab.FACTORED["neighbour"]
+
+
+@pytest.mark.parametrize("argv,message", [(["--rounds", "1"], "--rounds >= 2"),
+                                          (["--categories", "nowhere", "--data", "/nonexistent"],
+                                           "no dataset for nowhere")])
+def test_the_ab_command_line_refuses_bad_arguments(monkeypatch, capsys, argv, message):
+    from perception import interleaved_timing
+
+    switched = []
+    monkeypatch.setattr("sys.argv", ["ab", *argv])
+    with pytest.raises(SystemExit):
+        interleaved_timing.main("ab", switched.append, ("a", "b"))
+    assert message in capsys.readouterr().err
+    assert switched == []  # nothing was timed or switched
