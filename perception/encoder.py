@@ -39,6 +39,7 @@ class NeighbourEmbedding(nn.Module):
     The linear map W = [W_e, W_c] of the edge feature is applied before the neighbours are gathered:
     W (f_j - f_i, f_i) = (W_e f)_j + ((W_c - W_e) f)_i, so the products run over the n points rather
     than the n * k edges (k times fewer; the same result up to float rounding, the same parameters).
+    ``mlp[0]`` only holds W (its own ``forward`` is not called), so checkpoints keep their keys.
     """
 
     def __init__(self, channels: int) -> None:

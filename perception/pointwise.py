@@ -6,7 +6,10 @@ to float rounding. Only ``forward`` differs: one matrix product over the channel
 convolution call, which oneDNN runs more slowly than the equivalent GEMM on this project's 2-core CPU.
 The gain is small: interleaved A/B on the four shipped models (``scripts/pointwise_ab_timing.py``,
 session 29) made the forward pass 0.3-2.5 ms faster (24-33 ms), within the machine's noise for a
-whole ``predict`` call.
+whole ``predict`` call. Since session 30 the encoder's neighbour embedding only keeps its weights in a
+``PointwiseConv2d`` (so its ``state_dict`` is unchanged) and multiplies them itself before the
+neighbour gather (:class:`perception.encoder.NeighbourEmbedding`); the 2d layer's ``forward`` is not
+called by the model any more.
 """
 
 from __future__ import annotations
