@@ -5,6 +5,12 @@ Each checkpoint is run through :class:`perception.inference.ArticulationEstimato
 would call it (world-frame object points in, world-frame joints out). Position errors are given in the
 sample's normalised frame (divided by the bounding-box diagonal of its object points, as in the paper's
 normalised data) and in metres.
+
+``test_pose`` puts each test cloud in a new pose first, as the paper's test clouds are augmented too:
+``"world"`` keeps the stored world-frame clouds; ``"yaw"`` and ``"so3"`` apply a rigid transform
+(rotation about +z, or about x, y and z, each angle uniform in [-pi, pi]; translation uniform in
+[-1, 1] m per axis; no scaling, so metres stay metres), drawn from the sample's index alone, so every
+checkpoint sees the same posed clouds and a paired comparison stays paired.
 """
 
 from __future__ import annotations
@@ -17,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from perception.data import CaptShardDataset, Sample
+from perception.data import CaptShardDataset, Sample, augment
 from perception.inference import ArticulationEstimate, ArticulationEstimator
 from perception.metrics import (
     JointResult,
@@ -63,18 +69,34 @@ def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg
 
 
 WITHOUT_DV = "capt_without_dv"
+TEST_POSES = ("world", "yaw", "so3")
+TEST_POSE_SEED = 20240
+
+
+def posed_sample(sample: Sample, index: int, test_pose: str) -> Sample:
+    """``sample`` (world frame) in the test pose of split index ``index`` (see the module docstring);
+    ``"world"`` returns it unchanged."""
+    if test_pose not in TEST_POSES:
+        raise ValueError(f"test_pose must be one of {TEST_POSES}, got {test_pose!r}")
+    if test_pose == "world":
+        return sample
+    rng = np.random.default_rng([TEST_POSE_SEED, int(index)])
+    return augment(sample, rng, translation=1.0, scale_range=(1.0, 1.0), rotation=test_pose)
 
 
 def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str = "test",
              device: str = "cpu", timing_clouds: int = 100, max_samples: int | None = None,
-             progress: bool = True, without_double_voting: bool = False) -> EvaluationResult:
+             progress: bool = True, without_double_voting: bool = False,
+             test_pose: str = "world") -> EvaluationResult:
     """Evaluate each checkpoint on ``split``. The method name is the checkpoint's model variant, or
     ``"<variant> (<path>)"`` for every checkpoint whose variant is given more than once (e.g. two CAPT
     checkpoints compared), so no row overwrites another. ``without_double_voting`` also scores every
     CAPT checkpoint with the coarse vote only, as method ``capt_without_dv`` (the paper's "CAPT w/o
     DV": the motion loss's training without double voting's inference). Timing is the median of
     ``predict`` latency over at least ``timing_clouds`` single-cloud calls (cycling over the split if it
-    is smaller), after 3 warm-up calls."""
+    is smaller), after 3 warm-up calls. ``test_pose``: see the module docstring."""
+    if test_pose not in TEST_POSES:
+        raise ValueError(f"test_pose must be one of {TEST_POSES}, got {test_pose!r}")
     if len({str(p) for p in checkpoints}) != len(checkpoints):
         raise ValueError(f"a checkpoint is given twice: {[str(p) for p in checkpoints]}")
     estimators = [ArticulationEstimator.from_checkpoint(path, device=device) for path in checkpoints]
@@ -95,7 +117,7 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
     for method, est in runs:
         cfg = est.config.model
         ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples)
-        samples = [ds.sample(i) for i in range(len(ds))]
+        samples = [posed_sample(ds.sample(i), i, test_pose) for i in range(len(ds))]
         clouds = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]
         pairs = list(zip(samples, clouds, strict=True))
         for s, cloud in tqdm(pairs, desc=f"evaluate {method}", disable=not progress):

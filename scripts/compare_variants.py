@@ -66,7 +66,8 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     "paired": {method: {cat or "mean": {metric: {difference, low, high, reference_lower_share}}}}}.
     ``paired`` is empty when ``draws`` is 0, when the files hold no per-sample results, or when the
     reference method is not in them. ``only``: read just these methods from the files (e.g. leave
-    out a row one of several runs also scored); a listed method no file holds is a ValueError."""
+    out a row one of several runs also scored); a listed method no file holds is a ValueError, and so
+    are files scored in different test poses (``capt evaluate --test-pose``; absent means world)."""
     per_run: dict[str, dict[str, list[dict[str, float | None]]]] = {}
     samples: list[dict] = []
     seen: set[str] = set()
@@ -74,8 +75,10 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     def keep(method: str) -> bool:
         return only is None or method in only
 
+    poses: dict[str, list[str]] = {}
     for index, path in enumerate(paths):
         run = json.loads(path.read_text())
+        poses.setdefault(run.get("test_pose", "world"), []).append(str(path))
         seen.update(run["summary"])
         samples.extend({**s, "run": index} for s in run.get("samples", []) if keep(s["method"]))
         for method, cats in run["summary"].items():
@@ -83,6 +86,8 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
                 continue
             for cat, s in cats.items():
                 per_run.setdefault(cat, {}).setdefault(method, []).append(category_errors(s))
+    if len(poses) > 1:
+        raise ValueError(f"the inputs were scored in different test poses, which do not average: {poses}")
     absent = sorted(set(only or ()) - seen)
     if absent:
         raise ValueError(f"no input scored the method(s) {absent}; they hold {sorted(seen)}")
@@ -98,7 +103,7 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
         paired = {m: {c: {k: _as_dict(d) for k, d in by_metric.items()} for c, by_metric in rows.items()}
                   for m, rows in paired_differences(samples, reference, draws, seed, resample).items()}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths],
-            "only": only,
+            "only": only, "test_pose": next(iter(poses)),
             "reference": reference, "draws": draws, "seed": seed, "resample": resample, "paired": paired,
             "runs": {c: {m: len(runs) for m, runs in by_m.items()} for c, by_m in per_run.items()}}
 

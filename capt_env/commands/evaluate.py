@@ -20,6 +20,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--without-double-voting", action="store_true",
                         help="also score each CAPT checkpoint with the coarse vote only, as method "
                              "capt_without_dv (the paper's 'CAPT w/o DV')")
+    parser.add_argument("--test-pose", default="world", choices=["world", "yaw", "so3"],
+                        help="score the stored world-frame clouds (world), or each in a seeded rigid pose: "
+                             "rotation about +z (yaw) or about x, y and z (so3, as the paper's augmented "
+                             "test clouds), translation in [-1, 1] m; the same poses for every checkpoint")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -32,37 +36,39 @@ def run(args: argparse.Namespace) -> int:
     try:
         result = evaluate(args.checkpoints, args.data, split=args.split, device=args.device,
                           timing_clouds=args.timing_clouds, max_samples=args.max_samples,
-                          without_double_voting=args.without_double_voting)
+                          without_double_voting=args.without_double_voting, test_pose=args.test_pose)
     except (ValueError, CheckpointError, FileNotFoundError) as err:
         raise SystemExit(f"capt evaluate: {err}") from err
     timing = "\n".join(f"| {m} | {ms:.1f} |" for m, ms in result.median_ms.items())
-    text = (f"{result.table}\n\nTime per input (median over >= {args.timing_clouds} clouds, "
+    pose = "" if args.test_pose == "world" else f"Test clouds in {args.test_pose} poses (`--test-pose`).\n\n"
+    text = (f"{pose}{result.table}\n\nTime per input (median over >= {args.timing_clouds} clouds, "
             f"device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")
     print(text)
     if args.markdown:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
         Path(args.markdown).write_text(text)
     if args.figures:
-        _figures(args.checkpoints, args.data, args.split, Path(args.figures))
+        _figures(args.checkpoints, args.data, args.split, Path(args.figures), args.test_pose)
     methods = sorted({r.method for r in result.results})
     categories = sorted({r.category for r in result.results})
     summary = {m: {c: summarise([r for r in result.results if r.method == m and r.category == c])
                    for c in categories} for m in methods}
     write_json(args.json, {
-        "split": args.split, "data": args.data, "checkpoints": args.checkpoints,
+        "split": args.split, "test_pose": args.test_pose, "data": args.data, "checkpoints": args.checkpoints,
         "median_ms_per_input": result.median_ms, "summary": summary, "table_markdown": result.table,
         "samples": [dataclasses.asdict(r) for r in result.results],
     })
     return 0
 
 
-def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path) -> None:
-    """One picture per checkpoint: the first test cloud coloured by predicted part, axes red/green.
-    Named ``<category>_<variant>.png``, with the checkpoint's position appended (``_2``) when an earlier
-    checkpoint of the same variant already took that name."""
+def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path, test_pose: str = "world") -> None:
+    """One picture per checkpoint: the first test cloud (in its ``test_pose``) coloured by predicted part,
+    axes red/green. Named ``<category>_<variant>.png``, with the checkpoint's position appended (``_2``)
+    when an earlier checkpoint of the same variant already took that name."""
     import numpy as np
 
     from perception.data import CaptShardDataset
+    from perception.evaluation import posed_sample
     from perception.figures import plot_cloud_with_axes
     from perception.inference import ArticulationEstimator
 
@@ -70,6 +76,7 @@ def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path) -> No
     for i, path in enumerate(checkpoints, start=1):
         est = ArticulationEstimator.from_checkpoint(path)
         sample = CaptShardDataset(data, split, est.config.model, augment=False, max_samples=1).sample(0)
+        sample = posed_sample(sample, 0, test_pose)
         cloud = np.asarray(sample.points, np.float64)[np.asarray(sample.part_labels) >= 0]
         pred = est.predict(cloud)
         true = [(sample.joint_dirs[k], sample.joint_pivots[k]) for k in range(len(sample.joint_mask))

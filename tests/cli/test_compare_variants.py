@@ -112,6 +112,17 @@ def test_runs_scored_on_different_clouds_are_refused(tmp_path, load_script):
         cv.compare([seed0, seed1], draws=10)
 
 
+def test_runs_scored_in_different_test_poses_are_refused(tmp_path, load_script):
+    cv = load_script("compare_variants")
+    world = _run_file(tmp_path / "world.json", {"capt": 1.0, "capt_plain": 0.0}, n=20)
+    so3 = _run_file(tmp_path / "so3.json", {"capt": 1.0, "capt_plain": 0.0}, n=20)
+    so3.write_text(json.dumps({**json.loads(so3.read_text()), "test_pose": "so3"}))
+    with pytest.raises(ValueError, match="different test poses"):
+        cv.compare([world, so3], draws=10)
+    assert cv.compare([so3], draws=10)["test_pose"] == "so3"
+    assert cv.compare([world], draws=10)["test_pose"] == "world"  # files from before --test-pose
+
+
 def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys, load_script):
     cv = load_script("compare_variants")
     present = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})

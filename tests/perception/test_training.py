@@ -77,6 +77,14 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     with pytest.raises(ValueError, match="given twice"):
         evaluate([plain.best_path, plain.best_path], data_dir, "test", progress=False)
 
+    # the same clouds in new poses: other inputs, so other errors; the segmentation counts stay paired
+    posed = evaluate([resumed.best_path], data_dir, "test", timing_clouds=3, progress=False, test_pose="so3")
+    assert len(posed.results) == 4
+    assert [r.instance_id for r in posed.results] == [r.instance_id for r in before]
+    assert [r.joints for r in posed.results] != [r.joints for r in before]
+    with pytest.raises(ValueError, match="test_pose must be one of"):
+        evaluate([resumed.best_path], data_dir, "test", progress=False, test_pose="tilted")
+
 
 def test_resuming_with_more_epochs_replans_the_cosine_schedule(tmp_path, data_dir):
     import math
