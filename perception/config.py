@@ -153,7 +153,10 @@ class TrainConfig:
     """One training run. ``device`` is "auto" (CUDA when present), "cpu" or "cuda[:i]"; AMP is used on
     CUDA only. ``max_*_samples`` cap a split (None: all) for quick runs. ``rotation_augmentation``:
     ``so3`` is the paper's (rotation about x, y and z); ``yaw`` rotates about +z only, for clouds in a
-    world frame with known up direction (what a calibrated robot camera gives)."""
+    world frame with known up direction (what a calibrated robot camera gives). ``val_pose``: the
+    validation clouds (best epoch, double-voting window) as stored (``world``) or each in a fixed
+    seeded rigid pose (``yaw``, ``so3``; :func:`perception.data.posed_sample`), to match the poses
+    the model will be scored in (``capt evaluate --test-pose``)."""
 
     model: CaptConfig = field(default_factory=CaptConfig)
     epochs: int = 50
@@ -167,6 +170,7 @@ class TrainConfig:
     grad_clip: float = 1.0
     augment: bool = True
     rotation_augmentation: Literal["so3", "yaw"] = "so3"
+    val_pose: Literal["world", "yaw", "so3"] = "world"
     train_split: str = "train"
     val_split: str = "val"
     max_train_samples: int | None = None

@@ -199,6 +199,24 @@ def augment(sample: Sample, rng: np.random.Generator, translation: float = 1.0,
     )
 
 
+POSES = ("world", "yaw", "so3")
+POSE_SEED = 20240
+
+
+def posed_sample(sample: Sample, index: int, pose: str) -> Sample:
+    """``sample`` (world frame) in the fixed pose of split index ``index``: ``"world"`` returns it
+    unchanged; ``"yaw"`` and ``"so3"`` apply a rigid transform (rotation about +z, or about x, y and z,
+    each angle uniform in [-pi, pi]; translation uniform in [-1, 1] m per axis; no scaling, so metres
+    stay metres) drawn from the index alone. Validation and test clouds of SO(3)-trained models are
+    scored this way, the same poses for every checkpoint and every epoch."""
+    if pose not in POSES:
+        raise ValueError(f"pose must be one of {POSES}, got {pose!r}")
+    if pose == "world":
+        return sample
+    rng = np.random.default_rng([POSE_SEED, int(index)])
+    return augment(sample, rng, translation=1.0, scale_range=(1.0, 1.0), rotation=pose)
+
+
 def prepare_sample(sample: Sample, num_points: int, rng: np.random.Generator) -> dict[str, torch.Tensor]:
     """Drop background, resample to ``num_points``, normalise, compute targets; returns training tensors:
     points (n,3), part_labels (n,), joint_dirs (J,3), joint_pivots (J,3), joint_states (J,) (prismatic in
@@ -234,10 +252,15 @@ def prepare_sample(sample: Sample, num_points: int, rng: np.random.Generator) ->
 
 class CaptShardDataset(Dataset):
     """A split of a shard directory as training tensors (see module docstring). ``max_samples`` keeps
-    the first samples only. Call :meth:`set_epoch` each epoch to change the augmentation draw."""
+    the first samples only. ``pose`` puts every sample in its fixed seeded pose first (see
+    :func:`posed_sample`; validation and test clouds), before any augmentation. Call
+    :meth:`set_epoch` each epoch to change the augmentation draw."""
 
     def __init__(self, data_dir: str | Path, split: str, model: ModelConfig, augment: bool = False,
-                 seed: int = 0, max_samples: int | None = None, rotation: str = "so3") -> None:
+                 seed: int = 0, max_samples: int | None = None, rotation: str = "so3",
+                 pose: str = "world") -> None:
+        if pose not in POSES:
+            raise ValueError(f"pose must be one of {POSES}, got {pose!r}")
         arrays = fit_joint_slots(load_split(data_dir, split), model.max_joints)
         if max_samples is not None:
             arrays = {k: v[:max_samples] for k, v in arrays.items()}
@@ -245,6 +268,7 @@ class CaptShardDataset(Dataset):
         self.num_points = model.num_points
         self.augment = augment
         self.rotation = rotation
+        self.pose = pose
         self.seed = seed
         self.epoch = 0
         self._check(model)
@@ -269,9 +293,13 @@ class CaptShardDataset(Dataset):
         """The stored (un-augmented, world-frame) sample ``index``."""
         return Sample.from_arrays({k: v[index] for k, v in self.arrays.items()})
 
+    def posed(self, index: int) -> Sample:
+        """Sample ``index`` in this split's fixed ``pose`` (see :func:`posed_sample`)."""
+        return posed_sample(self.sample(index), index, self.pose)
+
     def __getitem__(self, index: int) -> dict[str, torch.Tensor]:
         rng = np.random.default_rng([self.seed, self.epoch, int(index)])
-        s = self.sample(index)
+        s = self.posed(index)
         if self.augment:
             s = augment(s, rng, rotation=self.rotation)
         item = prepare_sample(s, self.num_points, rng)

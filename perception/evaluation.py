@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from perception.data import CaptShardDataset, Sample, augment
+from perception.data import POSES, CaptShardDataset, Sample
 from perception.inference import ArticulationEstimate, ArticulationEstimator
 from perception.metrics import (
     JointResult,
@@ -69,20 +69,6 @@ def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg
 
 
 WITHOUT_DV = "capt_without_dv"
-TEST_POSES = ("world", "yaw", "so3")
-TEST_POSE_SEED = 20240
-
-
-def posed_sample(sample: Sample, index: int, test_pose: str) -> Sample:
-    """``sample`` (world frame) in the test pose of split index ``index`` (see the module docstring);
-    ``"world"`` returns it unchanged."""
-    if test_pose not in TEST_POSES:
-        raise ValueError(f"test_pose must be one of {TEST_POSES}, got {test_pose!r}")
-    if test_pose == "world":
-        return sample
-    rng = np.random.default_rng([TEST_POSE_SEED, int(index)])
-    return augment(sample, rng, translation=1.0, scale_range=(1.0, 1.0), rotation=test_pose)
-
 
 def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str = "test",
              device: str = "cpu", timing_clouds: int = 100, max_samples: int | None = None,
@@ -95,8 +81,8 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
     DV": the motion loss's training without double voting's inference). Timing is the median of
     ``predict`` latency over at least ``timing_clouds`` single-cloud calls (cycling over the split if it
     is smaller), after 3 warm-up calls. ``test_pose``: see the module docstring."""
-    if test_pose not in TEST_POSES:
-        raise ValueError(f"test_pose must be one of {TEST_POSES}, got {test_pose!r}")
+    if test_pose not in POSES:
+        raise ValueError(f"test_pose must be one of {POSES}, got {test_pose!r}")
     if len({str(p) for p in checkpoints}) != len(checkpoints):
         raise ValueError(f"a checkpoint is given twice: {[str(p) for p in checkpoints]}")
     estimators = [ArticulationEstimator.from_checkpoint(path, device=device) for path in checkpoints]
@@ -116,8 +102,8 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
     median_ms: dict[str, float] = {}
     for method, est in runs:
         cfg = est.config.model
-        ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples)
-        samples = [posed_sample(ds.sample(i), i, test_pose) for i in range(len(ds))]
+        ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples, pose=test_pose)
+        samples = [ds.posed(i) for i in range(len(ds))]
         clouds = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]
         pairs = list(zip(samples, clouds, strict=True))
         for s, cloud in tqdm(pairs, desc=f"evaluate {method}", disable=not progress):

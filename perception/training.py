@@ -164,7 +164,7 @@ def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume
                                 rotation=config.rotation_augmentation,
                                 max_samples=config.max_train_samples)
     val_ds = CaptShardDataset(data_dir, config.val_split, mcfg, augment=False, seed=config.seed + 1,
-                              max_samples=config.max_val_samples)
+                              max_samples=config.max_val_samples, pose=config.val_pose)
     category = str(train_ds.arrays["category"][0]) if len(train_ds) else ""
     model = CaptModel(mcfg).to(device)
     optimizer = torch.optim.AdamW(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)

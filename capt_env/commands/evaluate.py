@@ -68,15 +68,14 @@ def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path, test_
     import numpy as np
 
     from perception.data import CaptShardDataset
-    from perception.evaluation import posed_sample
     from perception.figures import plot_cloud_with_axes
     from perception.inference import ArticulationEstimator
 
     taken: set[str] = set()
     for i, path in enumerate(checkpoints, start=1):
         est = ArticulationEstimator.from_checkpoint(path)
-        sample = CaptShardDataset(data, split, est.config.model, augment=False, max_samples=1).sample(0)
-        sample = posed_sample(sample, 0, test_pose)
+        sample = CaptShardDataset(data, split, est.config.model, augment=False, max_samples=1,
+                                  pose=test_pose).posed(0)
         cloud = np.asarray(sample.points, np.float64)[np.asarray(sample.part_labels) >= 0]
         pred = est.predict(cloud)
         true = [(sample.joint_dirs[k], sample.joint_pivots[k]) for k in range(len(sample.joint_mask))
