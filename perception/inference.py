@@ -1,6 +1,8 @@
 """The public API of CAPT inference (paper Sec. III, end to end): cloud in, segmentation and joints out.
 
-``ArticulationEstimator.predict(points)`` takes one (N, 3) cloud in any frame, in metres, and does:
+``ArticulationEstimator.predict(points)`` takes one (N, 3) cloud in metres, in any position and heading
+(a model trained with ``rotation_augmentation: yaw``, as the shipped ones, needs the frame's +z up;
+one trained with ``so3`` takes any orientation), and does:
 bounding-box normalisation -> deterministic resampling to ``num_points`` (seeded) -> network ->
 (double) voting -> back to the caller's frame. Part labels of points that were not fed to the network
 are those of their nearest fed point. Revolute pivots are returned as the point of the axis closest to
@@ -140,7 +142,8 @@ class ArticulationEstimator:
                    double_voting)
 
     def predict(self, points: np.ndarray) -> ArticulationEstimate:
-        """Estimate segmentation and joints of one cloud ``points`` (N, 3) float, metres, any frame."""
+        """Estimate segmentation and joints of one cloud ``points`` (N, 3) float, metres, in the caller's
+        frame (+z up for a yaw-trained model; see the module docstring)."""
         return self.predict_batch([points])[0]
 
     @torch.no_grad()
