@@ -70,6 +70,7 @@ def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg
 
 WITHOUT_DV = "capt_without_dv"
 
+
 def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str = "test",
              device: str = "cpu", timing_clouds: int = 100, max_samples: int | None = None,
              progress: bool = True, without_double_voting: bool = False,
