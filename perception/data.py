@@ -203,14 +203,19 @@ POSES = ("world", "yaw", "so3")
 POSE_SEED = 20240
 
 
+def check_pose(pose: str, name: str = "pose") -> None:
+    """ValueError naming ``name`` unless ``pose`` is one of :data:`POSES`."""
+    if pose not in POSES:
+        raise ValueError(f"{name} must be one of {POSES}, got {pose!r}")
+
+
 def posed_sample(sample: Sample, index: int, pose: str) -> Sample:
     """``sample`` (world frame) in the fixed pose of split index ``index``: ``"world"`` returns it
     unchanged; ``"yaw"`` and ``"so3"`` apply a rigid transform (rotation about +z, or about x, y and z,
     each angle uniform in [-pi, pi]; translation uniform in [-1, 1] m per axis; no scaling, so metres
-    stay metres) drawn from the index alone. Validation and test clouds of SO(3)-trained models are
-    scored this way, the same poses for every checkpoint and every epoch."""
-    if pose not in POSES:
-        raise ValueError(f"pose must be one of {POSES}, got {pose!r}")
+    stay metres) drawn from the index alone. Validation (``TrainConfig.val_pose``) and test clouds
+    (``capt evaluate --test-pose``) are posed this way, the same for every checkpoint and epoch."""
+    check_pose(pose)
     if pose == "world":
         return sample
     rng = np.random.default_rng([POSE_SEED, int(index)])
@@ -259,8 +264,7 @@ class CaptShardDataset(Dataset):
     def __init__(self, data_dir: str | Path, split: str, model: ModelConfig, augment: bool = False,
                  seed: int = 0, max_samples: int | None = None, rotation: str = "so3",
                  pose: str = "world") -> None:
-        if pose not in POSES:
-            raise ValueError(f"pose must be one of {POSES}, got {pose!r}")
+        check_pose(pose)
         arrays = fit_joint_slots(load_split(data_dir, split), model.max_joints)
         if max_samples is not None:
             arrays = {k: v[:max_samples] for k, v in arrays.items()}

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from perception.data import POSES, CaptShardDataset, Sample
+from perception.data import CaptShardDataset, Sample, check_pose
 from perception.inference import ArticulationEstimate, ArticulationEstimator
 from perception.metrics import (
     JointResult,
@@ -82,8 +82,7 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
     DV": the motion loss's training without double voting's inference). Timing is the median of
     ``predict`` latency over at least ``timing_clouds`` single-cloud calls (cycling over the split if it
     is smaller), after 3 warm-up calls. ``test_pose``: see the module docstring."""
-    if test_pose not in POSES:
-        raise ValueError(f"test_pose must be one of {POSES}, got {test_pose!r}")
+    check_pose(test_pose, "test_pose")
     if len({str(p) for p in checkpoints}) != len(checkpoints):
         raise ValueError(f"a checkpoint is given twice: {[str(p) for p in checkpoints]}")
     estimators = [ArticulationEstimator.from_checkpoint(path, device=device) for path in checkpoints]
