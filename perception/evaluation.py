@@ -11,18 +11,23 @@ normalised data) and in metres.
 (rotation about +z, or about x, y and z, each angle uniform in [-pi, pi]; translation uniform in
 [-1, 1] m per axis; no scaling, so metres stay metres), drawn from the sample's index alone, so every
 checkpoint sees the same posed clouds and a paired comparison stays paired.
+
+``corruption`` (:mod:`perception.corruption`) then adds seeded sensor noise to each posed cloud: Gaussian
+jitter and stray points. Ground truth and the normalised frame's scale stay those of the clean cloud;
+segmentation is scored on the cloud's own points, not on the stray ones.
 """
 
 from __future__ import annotations
 
 import statistics
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
+from perception.corruption import Corruption, corrupt_cloud
 from perception.data import CaptShardDataset, Sample, check_pose
 from perception.inference import ArticulationEstimate, ArticulationEstimator
 from perception.metrics import (
@@ -74,14 +79,15 @@ WITHOUT_DV = "capt_without_dv"
 def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str = "test",
              device: str = "cpu", timing_clouds: int = 100, max_samples: int | None = None,
              progress: bool = True, without_double_voting: bool = False,
-             test_pose: str = "world") -> EvaluationResult:
+             test_pose: str = "world", corruption: Corruption | None = None) -> EvaluationResult:
     """Evaluate each checkpoint on ``split``. The method name is the checkpoint's model variant, or
     ``"<variant> (<path>)"`` for every checkpoint whose variant is given more than once (e.g. two CAPT
     checkpoints compared), so no row overwrites another. ``without_double_voting`` also scores every
     CAPT checkpoint with the coarse vote only, as method ``capt_without_dv`` (the paper's "CAPT w/o
     DV": the motion loss's training without double voting's inference). Timing is the median of
     ``predict`` latency over at least ``timing_clouds`` single-cloud calls (cycling over the split if it
-    is smaller), after 3 warm-up calls. ``test_pose``: see the module docstring."""
+    is smaller), after 3 warm-up calls, on the clouds as scored. ``test_pose`` and ``corruption``: see the
+    module docstring."""
     check_pose(test_pose, "test_pose")
     if len({str(p) for p in checkpoints}) != len(checkpoints):
         raise ValueError(f"a checkpoint is given twice: {[str(p) for p in checkpoints]}")
@@ -104,10 +110,14 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
         cfg = est.config.model
         ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples, pose=test_pose)
         samples = [ds.posed(i) for i in range(len(ds))]
-        clouds = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]
-        pairs = list(zip(samples, clouds, strict=True))
-        for s, cloud in tqdm(pairs, desc=f"evaluate {method}", disable=not progress):
-            results.append(score_sample(est.predict(cloud), s, method, cfg.has_segmentation))
+        clean = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]
+        clouds = [corrupt_cloud(c, i, corruption) for i, c in enumerate(clean)] if corruption else clean
+        for s, n, cloud in tqdm(list(zip(samples, map(len, clean), clouds, strict=True)),
+                                desc=f"evaluate {method}", disable=not progress):
+            pred = est.predict(cloud)
+            if len(cloud) > n:  # stray points appended by the corruption have no true part
+                pred = replace(pred, part_labels=pred.part_labels[:n])
+            results.append(score_sample(pred, s, method, cfg.has_segmentation))
         for c in clouds[:3]:
             est.predict(c)
         count = max(timing_clouds, len(clouds))

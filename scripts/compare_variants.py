@@ -39,6 +39,8 @@ from perception.paired_comparison import RESAMPLE_UNITS, PairedDifference, paire
 # (key, column label); the keys are perception.paired_comparison's, in its order
 METRICS = tuple(zip(PAIRED_METRICS, ("direction (deg)", "position (normalised)", "state, revolute (deg)",
                                      "state, prismatic (m)"), strict=True))
+# what a `capt evaluate --json` file without "test_corruption" (older than the key) was scored with
+CLEAN = {"jitter_m": 0.0, "outlier_fraction": 0.0}
 TABLE_HEAD = ["| category | method | " + " | ".join(label for _, label in METRICS) + " |",
               "|" + " --- |" * (len(METRICS) + 2)]
 
@@ -67,7 +69,8 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     ``paired`` is empty when ``draws`` is 0, when the files hold no per-sample results, or when the
     reference method is not in them. ``only``: read just these methods from the files (e.g. leave
     out a row one of several runs also scored); a listed method no file holds is a ValueError, and so
-    are files scored in different test poses (``capt evaluate --test-pose``; absent means world)."""
+    are files scored in different test poses (``capt evaluate --test-pose``; absent means world) or
+    with different sensor corruptions (``--test-jitter``, ``--test-outliers``; absent means none)."""
     per_run: dict[str, dict[str, list[dict[str, float | None]]]] = {}
     samples: list[dict] = []
     seen: set[str] = set()
@@ -76,9 +79,12 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
         return only is None or method in only
 
     poses: dict[str, list[str]] = {}
+    corruptions: dict[str, list[str]] = {}
     for index, path in enumerate(paths):
         run = json.loads(path.read_text())
         poses.setdefault(run.get("test_pose", "world"), []).append(str(path))
+        corruption = json.dumps(run.get("test_corruption", CLEAN), sort_keys=True)
+        corruptions.setdefault(corruption, []).append(str(path))
         seen.update(run["summary"])
         samples.extend({**s, "run": index} for s in run.get("samples", []) if keep(s["method"]))
         for method, cats in run["summary"].items():
@@ -88,6 +94,9 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
                 per_run.setdefault(cat, {}).setdefault(method, []).append(category_errors(s))
     if len(poses) > 1:
         raise ValueError(f"the inputs were scored in different test poses, which do not average: {poses}")
+    if len(corruptions) > 1:
+        raise ValueError(f"the inputs were scored with different test corruptions, which do not average: "
+                         f"{corruptions}")
     absent = sorted(set(only or ()) - seen)
     if absent:
         raise ValueError(f"no input scored the method(s) {absent}; they hold {sorted(seen)}")
@@ -104,6 +113,7 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
                   for m, rows in paired_differences(samples, reference, draws, seed, resample).items()}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths],
             "only": only, "test_pose": next(iter(poses)),
+            "test_corruption": json.loads(next(iter(corruptions))),
             "reference": reference, "draws": draws, "seed": seed, "resample": resample, "paired": paired,
             "runs": {c: {m: len(runs) for m, runs in by_m.items()} for c, by_m in per_run.items()}}
 

@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from capt_env.commands.json_output import write_json
+
+if TYPE_CHECKING:
+    from perception.corruption import Corruption
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,49 +28,63 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="score the stored world-frame clouds (world), or each in a seeded rigid pose: "
                              "rotation about +z (yaw) or about x, y and z (so3, as the paper's augmented "
                              "test clouds), translation in [-1, 1] m; the same poses for every checkpoint")
+    parser.add_argument("--test-jitter", type=float, default=0.0, metavar="METRES",
+                        help="add seeded Gaussian noise with this standard deviation (metres) to every test "
+                             "point, the same noise for every checkpoint")
+    parser.add_argument("--test-outliers", type=float, default=0.0, metavar="FRACTION",
+                        help="append this fraction (of the cloud's points) of seeded stray points, uniform "
+                             "in the cloud's bounding box; segmentation is scored on the cloud's own points")
 
 
 def run(args: argparse.Namespace) -> int:
     import dataclasses
 
     from perception.checkpoint import CheckpointError
+    from perception.corruption import Corruption
     from perception.evaluation import evaluate
     from perception.metrics import summarise
 
     try:
+        corruption = Corruption(jitter_m=args.test_jitter, outlier_fraction=args.test_outliers)
         result = evaluate(args.checkpoints, args.data, split=args.split, device=args.device,
                           timing_clouds=args.timing_clouds, max_samples=args.max_samples,
-                          without_double_voting=args.without_double_voting, test_pose=args.test_pose)
+                          without_double_voting=args.without_double_voting, test_pose=args.test_pose,
+                          corruption=corruption)
     except (ValueError, CheckpointError, FileNotFoundError) as err:
         raise SystemExit(f"capt evaluate: {err}") from err
     timing = "\n".join(f"| {m} | {ms:.1f} |" for m, ms in result.median_ms.items())
     pose = "" if args.test_pose == "world" else f"Test clouds in {args.test_pose} poses (`--test-pose`).\n\n"
-    text = (f"{pose}{result.table}\n\nTime per input (median over >= {args.timing_clouds} clouds, "
+    noise = "" if corruption.is_clean else f"Test clouds corrupted: {corruption.describe()}.\n\n"
+    text = (f"{pose}{noise}{result.table}\n\nTime per input (median over >= {args.timing_clouds} clouds, "
             f"device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")
     print(text)
     if args.markdown:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
         Path(args.markdown).write_text(text)
     if args.figures:
-        _figures(args.checkpoints, args.data, args.split, Path(args.figures), args.test_pose)
+        _figures(args.checkpoints, args.data, args.split, Path(args.figures), args.test_pose, corruption)
     methods = sorted({r.method for r in result.results})
     categories = sorted({r.category for r in result.results})
     summary = {m: {c: summarise([r for r in result.results if r.method == m and r.category == c])
                    for c in categories} for m in methods}
     write_json(args.json, {
-        "split": args.split, "test_pose": args.test_pose, "data": args.data, "checkpoints": args.checkpoints,
+        "split": args.split, "test_pose": args.test_pose, "test_corruption": dataclasses.asdict(corruption),
+        "data": args.data, "checkpoints": args.checkpoints,
         "median_ms_per_input": result.median_ms, "summary": summary, "table_markdown": result.table,
         "samples": [dataclasses.asdict(r) for r in result.results],
     })
     return 0
 
 
-def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path, test_pose: str = "world") -> None:
-    """One picture per checkpoint: the first test cloud (in its ``test_pose``) coloured by predicted part,
+def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path, test_pose: str = "world",
+             corruption: Corruption | None = None) -> None:
+    """One picture per checkpoint: the first test cloud (in its ``test_pose``, with its ``corruption``,
+    stray points included) coloured by predicted part,
     axes red/green. Named ``<category>_<variant>.png``, with the checkpoint's position appended (``_2``)
     when an earlier checkpoint of the same variant already took that name."""
     import numpy as np
 
+    from perception.corruption import corrupt_cloud
     from perception.data import CaptShardDataset
     from perception.figures import plot_cloud_with_axes
     from perception.inference import ArticulationEstimator
@@ -77,6 +95,8 @@ def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path, test_
         sample = CaptShardDataset(data, split, est.config.model, augment=False, max_samples=1,
                                   pose=test_pose).posed(0)
         cloud = np.asarray(sample.points, np.float64)[np.asarray(sample.part_labels) >= 0]
+        if corruption is not None:
+            cloud = corrupt_cloud(cloud, 0, corruption)
         pred = est.predict(cloud)
         true = [(sample.joint_dirs[k], sample.joint_pivots[k]) for k in range(len(sample.joint_mask))
                 if sample.joint_mask[k]]

@@ -186,3 +186,7 @@ def test_evaluate_names_bad_input_without_a_traceback(tmp_path: Path) -> None:
         main(["evaluate", str(tmp_path / "missing.pt"), "--data", str(tmp_path)])
     with pytest.raises(SystemExit, match="capt evaluate: no shard_"):
         main(["evaluate", shipped, "--data", str(tmp_path)])
+    with pytest.raises(SystemExit, match="capt evaluate: jitter_m must be a finite number >= 0"):
+        main(["evaluate", shipped, "--data", str(tmp_path), "--test-jitter", "-0.01"])
+    with pytest.raises(SystemExit, match=r"capt evaluate: outlier_fraction must be in \[0, 1\]"):
+        main(["evaluate", shipped, "--data", str(tmp_path), "--test-outliers", "2"])

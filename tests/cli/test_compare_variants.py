@@ -123,6 +123,18 @@ def test_runs_scored_in_different_test_poses_are_refused(tmp_path, load_script):
     assert cv.compare([world], draws=10)["test_pose"] == "world"  # files from before --test-pose
 
 
+def test_runs_scored_with_different_test_corruptions_are_refused(tmp_path, load_script):
+    cv = load_script("compare_variants")
+    clean = _run_file(tmp_path / "clean.json", {"capt": 1.0, "capt_plain": 0.0}, n=20)
+    noisy = _run_file(tmp_path / "noisy.json", {"capt": 1.0, "capt_plain": 0.0}, n=20)
+    corruption = {"jitter_m": 0.005, "outlier_fraction": 0.0}
+    noisy.write_text(json.dumps({**json.loads(noisy.read_text()), "test_corruption": corruption}))
+    with pytest.raises(ValueError, match="different test corruptions"):
+        cv.compare([clean, noisy], draws=10)
+    assert cv.compare([noisy], draws=10)["test_corruption"] == corruption
+    assert cv.compare([clean], draws=10)["test_corruption"] == cv.CLEAN  # files from before the key
+
+
 def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys, load_script):
     cv = load_script("compare_variants")
     present = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})

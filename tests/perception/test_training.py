@@ -9,6 +9,7 @@ import pytest
 from capt_env.commands.train import epoch_seconds
 from perception.checkpoint import load_checkpoint
 from perception.config import CaptConfig, TrainConfig
+from perception.corruption import Corruption
 from perception.data import write_dataset
 from perception.evaluation import evaluate
 from perception.training import train
@@ -84,6 +85,16 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     assert [r.joints for r in posed.results] != [r.joints for r in before]
     with pytest.raises(ValueError, match="test_pose must be one of"):
         evaluate([resumed.best_path], data_dir, "test", progress=False, test_pose="tilted")
+
+    # sensor corruption: other inputs, the same clouds and ground truth; stray points are not scored
+    noisy = evaluate([resumed.best_path], data_dir, "test", timing_clouds=3, progress=False,
+                     corruption=Corruption(jitter_m=0.01, outlier_fraction=0.2))
+    assert [r.instance_id for r in noisy.results] == [r.instance_id for r in before]
+    assert all(r.pa is not None and 0 <= r.pa <= 1 for r in noisy.results)
+    assert [r.joints for r in noisy.results] != [r.joints for r in before]
+    clean = evaluate([resumed.best_path], data_dir, "test", timing_clouds=3, progress=False,
+                     corruption=Corruption())
+    assert [(r.pa, r.joints) for r in clean.results] == [(r.pa, r.joints) for r in before]
 
 
 def test_resuming_with_more_epochs_replans_the_cosine_schedule(tmp_path, data_dir):
