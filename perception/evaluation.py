@@ -14,7 +14,8 @@ checkpoint sees the same posed clouds and a paired comparison stays paired.
 
 ``corruption`` (:mod:`perception.corruption`) then adds seeded sensor noise to each posed cloud: Gaussian
 jitter and stray points. Ground truth and the normalised frame's scale stay those of the clean cloud;
-segmentation is scored on the cloud's own points, not on the stray ones.
+segmentation is scored on the cloud's own points, not on the stray ones. ``outlier_filter``
+(:mod:`perception.outlier_filter`) makes every checkpoint drop stray points before its network.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from perception.metrics import (
     table_markdown,
 )
 from perception.normalisation import Normalisation
+from perception.outlier_filter import OutlierFilter
 
 
 @dataclass(frozen=True)
@@ -79,19 +81,21 @@ WITHOUT_DV = "capt_without_dv"
 def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str = "test",
              device: str = "cpu", timing_clouds: int = 100, max_samples: int | None = None,
              progress: bool = True, without_double_voting: bool = False,
-             test_pose: str = "world", corruption: Corruption | None = None) -> EvaluationResult:
+             test_pose: str = "world", corruption: Corruption | None = None,
+             outlier_filter: OutlierFilter | None = None) -> EvaluationResult:
     """Evaluate each checkpoint on ``split``. The method name is the checkpoint's model variant, or
     ``"<variant> (<path>)"`` for every checkpoint whose variant is given more than once (e.g. two CAPT
     checkpoints compared), so no row overwrites another. ``without_double_voting`` also scores every
     CAPT checkpoint with the coarse vote only, as method ``capt_without_dv`` (the paper's "CAPT w/o
     DV": the motion loss's training without double voting's inference). Timing is the median of
     ``predict`` latency over at least ``timing_clouds`` single-cloud calls (cycling over the split if it
-    is smaller), after 3 warm-up calls, on the clouds as scored. ``test_pose`` and ``corruption``: see the
-    module docstring."""
+    is smaller), after 3 warm-up calls, on the clouds as scored. ``test_pose``, ``corruption`` and
+    ``outlier_filter``: see the module docstring."""
     check_pose(test_pose, "test_pose")
     if len({str(p) for p in checkpoints}) != len(checkpoints):
         raise ValueError(f"a checkpoint is given twice: {[str(p) for p in checkpoints]}")
-    estimators = [ArticulationEstimator.from_checkpoint(path, device=device) for path in checkpoints]
+    estimators = [ArticulationEstimator.from_checkpoint(path, device=device, outlier_filter=outlier_filter)
+                  for path in checkpoints]
     variants = [e.config.model.variant for e in estimators]
     if without_double_voting and "capt" not in variants:
         raise ValueError(f"without_double_voting needs a capt checkpoint to score without double voting; "
@@ -103,7 +107,7 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
         if without_double_voting and variant == "capt":
             runs.append((WITHOUT_DV + suffix,
                          ArticulationEstimator(est.model, est.config, est.voting_window, est.category, device,
-                                               est.seed, double_voting=False)))
+                                               est.seed, double_voting=False, outlier_filter=outlier_filter)))
     results: list[SampleResult] = []
     median_ms: dict[str, float] = {}
     for method, est in runs:

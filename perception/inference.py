@@ -26,6 +26,7 @@ from perception.checkpoint import build_model, load_checkpoint
 from perception.config import JOINT_TYPE_CODES, CaptConfig
 from perception.model import CaptModel, CaptOutput
 from perception.normalisation import Normalisation
+from perception.outlier_filter import OutlierFilter, inlier_mask
 from perception.voting import PointPredictions, vote
 
 MIN_POINTS = 32
@@ -112,10 +113,13 @@ class ArticulationEstimator:
 
     def __init__(self, model: CaptModel, config: CaptConfig, voting_window: tuple[float, float] | None = None,
                  category: str = "", device: str | torch.device = "cpu", seed: int = 0,
-                 double_voting: bool | None = None) -> None:
+                 double_voting: bool | None = None, outlier_filter: OutlierFilter | None = None) -> None:
         """``double_voting``: None votes as the variant was trained to (CAPT twice, CAPT-plain once);
         False makes a CAPT checkpoint vote once, the coarse mean (the paper's "CAPT w/o DV"). True is
-        only for CAPT: its voting window was chosen on validation, CAPT-plain's never was."""
+        only for CAPT: its voting window was chosen on validation, CAPT-plain's never was.
+        ``outlier_filter``: drop stray points (:mod:`perception.outlier_filter`) before normalisation and
+        the network; the dropped points still get a part label, their nearest fed point's. None (the
+        default) feeds every point."""
         variant = config.model.variant
         if double_voting is not None and variant == "pct_regression":
             raise ValueError("double_voting does not apply to a pct_regression checkpoint: it regresses "
@@ -131,15 +135,25 @@ class ArticulationEstimator:
         self.category = category
         self.seed = seed
         self.joint_types = tuple(config.model.joint_types)
+        self.outlier_filter = outlier_filter
 
     @classmethod
     def from_checkpoint(cls, path: str | Path, device: str | torch.device = "cpu", seed: int = 0,
-                        double_voting: bool | None = None) -> ArticulationEstimator:
+                        double_voting: bool | None = None,
+                        outlier_filter: OutlierFilter | None = None) -> ArticulationEstimator:
         """Load a checkpoint written by :func:`perception.checkpoint.save_checkpoint`
-        (``double_voting`` as in the constructor)."""
+        (``double_voting`` and ``outlier_filter`` as in the constructor)."""
         ckpt = load_checkpoint(path)
         return cls(build_model(ckpt, device), ckpt.config, ckpt.voting_window, ckpt.category, device, seed,
-                   double_voting)
+                   double_voting, outlier_filter)
+
+    def _fed_points(self, points: np.ndarray) -> np.ndarray:
+        """Indices of the points of one checked cloud that may be fed to the network: all of them, or the
+        inliers of ``outlier_filter`` (all of them when it would keep fewer than the minimum)."""
+        if self.outlier_filter is None:
+            return np.arange(len(points))
+        keep = np.flatnonzero(inlier_mask(points, self.outlier_filter))
+        return keep if len(keep) >= MIN_POINTS else np.arange(len(points))
 
     def predict(self, points: np.ndarray) -> ArticulationEstimate:
         """Estimate segmentation and joints of one cloud ``points`` (N, 3) float, metres, in the caller's
@@ -154,8 +168,9 @@ class ArticulationEstimator:
             return []
         checked = [check_points(c) for c in clouds]
         n = self.config.model.num_points
-        norms = [Normalisation.fit(c) for c in checked]
-        idxs = [resample_indices(len(c), n, self.seed) for c in checked]
+        fed = [self._fed_points(c) for c in checked]
+        norms = [Normalisation.fit(c[f]) for c, f in zip(checked, fed, strict=True)]
+        idxs = [f[resample_indices(len(f), n, self.seed)] for f in fed]
         net_in = np.stack([nm.points(c[i]) for nm, c, i in zip(norms, checked, idxs, strict=True)])
         net_in = net_in.astype(np.float32)
         out = self.model(torch.from_numpy(net_in).to(self.device))

@@ -70,7 +70,8 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     reference method is not in them. ``only``: read just these methods from the files (e.g. leave
     out a row one of several runs also scored); a listed method no file holds is a ValueError, and so
     are files scored in different test poses (``capt evaluate --test-pose``; absent means world) or
-    with different sensor corruptions (``--test-jitter``, ``--test-outliers``; absent means none)."""
+    with different sensor corruptions (``--test-jitter``, ``--test-outliers``; absent means none) or
+    outlier filters (``--filter-outliers``; absent means none)."""
     per_run: dict[str, dict[str, list[dict[str, float | None]]]] = {}
     samples: list[dict] = []
     seen: set[str] = set()
@@ -83,7 +84,8 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     for index, path in enumerate(paths):
         run = json.loads(path.read_text())
         poses.setdefault(run.get("test_pose", "world"), []).append(str(path))
-        corruption = json.dumps(run.get("test_corruption", CLEAN), sort_keys=True)
+        corruption = json.dumps({"test_corruption": run.get("test_corruption", CLEAN),
+                                 "outlier_filter": run.get("outlier_filter")}, sort_keys=True)
         corruptions.setdefault(corruption, []).append(str(path))
         seen.update(run["summary"])
         samples.extend({**s, "run": index} for s in run.get("samples", []) if keep(s["method"]))
@@ -95,8 +97,8 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     if len(poses) > 1:
         raise ValueError(f"the inputs were scored in different test poses, which do not average: {poses}")
     if len(corruptions) > 1:
-        raise ValueError(f"the inputs were scored with different test corruptions, which do not average: "
-                         f"{corruptions}")
+        raise ValueError(f"the inputs were scored with different test corruptions or outlier filters, "
+                         f"which do not average: {corruptions}")
     absent = sorted(set(only or ()) - seen)
     if absent:
         raise ValueError(f"no input scored the method(s) {absent}; they hold {sorted(seen)}")
@@ -113,7 +115,7 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
                   for m, rows in paired_differences(samples, reference, draws, seed, resample).items()}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths],
             "only": only, "test_pose": next(iter(poses)),
-            "test_corruption": json.loads(next(iter(corruptions))),
+            **json.loads(next(iter(corruptions))),
             "reference": reference, "draws": draws, "seed": seed, "resample": resample, "paired": paired,
             "runs": {c: {m: len(runs) for m, runs in by_m.items()} for c, by_m in per_run.items()}}
 

@@ -190,3 +190,7 @@ def test_evaluate_names_bad_input_without_a_traceback(tmp_path: Path) -> None:
         main(["evaluate", shipped, "--data", str(tmp_path), "--test-jitter", "-0.01"])
     with pytest.raises(SystemExit, match=r"capt evaluate: outlier_fraction must be in \[0, 1\]"):
         main(["evaluate", shipped, "--data", str(tmp_path), "--test-outliers", "2"])
+    with pytest.raises(SystemExit, match="capt evaluate: --filter-neighbours and --filter-std-ratio need"):
+        main(["evaluate", shipped, "--data", str(tmp_path), "--filter-std-ratio", "2"])
+    with pytest.raises(SystemExit, match="capt evaluate: neighbours must be an integer >= 1"):
+        main(["evaluate", shipped, "--data", str(tmp_path), "--filter-outliers", "--filter-neighbours", "0"])

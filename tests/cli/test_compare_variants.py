@@ -133,6 +133,12 @@ def test_runs_scored_with_different_test_corruptions_are_refused(tmp_path, load_
         cv.compare([clean, noisy], draws=10)
     assert cv.compare([noisy], draws=10)["test_corruption"] == corruption
     assert cv.compare([clean], draws=10)["test_corruption"] == cv.CLEAN  # files from before the key
+    filtered = _run_file(tmp_path / "filtered.json", {"capt": 1.0, "capt_plain": 0.0}, n=20)
+    filtered.write_text(json.dumps({**json.loads(filtered.read_text()),
+                                    "outlier_filter": {"neighbours": 8, "std_ratio": 3.0}}))
+    with pytest.raises(ValueError, match="different test corruptions or outlier filters"):
+        cv.compare([clean, filtered], draws=10)
+    assert cv.compare([filtered], draws=10)["outlier_filter"] == {"neighbours": 8, "std_ratio": 3.0}
 
 
 def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys, load_script):

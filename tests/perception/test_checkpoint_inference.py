@@ -136,3 +136,24 @@ def test_predict_rejects_bad_input(tmp_path, points, message):
     est = ArticulationEstimator.from_checkpoint(path)
     with pytest.raises(ValueError, match=message):
         est.predict(points)
+
+
+def test_the_outlier_filter_feeds_only_the_inliers(tmp_path):
+    from perception.outlier_filter import OutlierFilter, inlier_mask
+
+    path, _, _ = _save(tmp_path)
+    pts = make_samples(1, num_points=300)[0].points.astype(np.float64)
+    far = pts.mean(axis=0) + np.random.default_rng(1).normal(0, 1.0, (15, 3))  # strays around the object
+    noisy = np.concatenate([pts, far])
+    filt = OutlierFilter()
+    keep = inlier_mask(noisy, filt)
+    assert not keep[300:].any()
+    plain = ArticulationEstimator.from_checkpoint(path)
+    filtered = ArticulationEstimator.from_checkpoint(path, outlier_filter=filt).predict(noisy)
+    # the filter's answer is the unfiltered estimator's on the kept points; every input point is labelled
+    same = plain.predict(noisy[keep]).joints[0]
+    assert filtered.part_labels.shape == (315,)
+    assert np.allclose(filtered.joints[0].direction, same.direction, atol=1e-6)
+    assert np.allclose(filtered.joints[0].pivot, same.pivot, atol=1e-6)
+    # and the strays change the unfiltered answer (they move the bounding box the cloud is normalised by)
+    assert not np.allclose(plain.predict(noisy).joints[0].pivot, same.pivot, atol=1e-3)

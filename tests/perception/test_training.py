@@ -12,6 +12,7 @@ from perception.config import CaptConfig, TrainConfig
 from perception.corruption import Corruption
 from perception.data import write_dataset
 from perception.evaluation import evaluate
+from perception.outlier_filter import OutlierFilter
 from perception.training import train
 
 from .helpers import make_samples, tiny_model_config
@@ -95,6 +96,9 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     clean = evaluate([resumed.best_path], data_dir, "test", timing_clouds=3, progress=False,
                      corruption=Corruption())
     assert [(r.pa, r.joints) for r in clean.results] == [(r.pa, r.joints) for r in before]
+    filtered = evaluate([resumed.best_path], data_dir, "test", timing_clouds=3, progress=False,
+                        corruption=Corruption(outlier_fraction=0.2), outlier_filter=OutlierFilter())
+    assert len(filtered.results) == 4 and all(r.pa is not None for r in filtered.results)
 
 
 def test_resuming_with_more_epochs_replans_the_cosine_schedule(tmp_path, data_dir):
