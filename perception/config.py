@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
+from perception.corruption import Corruption
 from perception.yaml_config import require
 
 Variant = Literal["capt", "capt_plain", "pct_regression"]
@@ -156,7 +157,10 @@ class TrainConfig:
     world frame with known up direction (what a calibrated robot camera gives). ``val_pose``: the
     validation clouds (best epoch, double-voting window) as stored (``world``) or each in a fixed
     seeded rigid pose (``yaw``, ``so3``; :func:`perception.data.posed_sample`), to match the poses
-    the model will be scored in (``capt evaluate --test-pose``)."""
+    the model will be scored in (``capt evaluate --test-pose``). ``sensor_noise``: Gaussian jitter
+    (metres) and stray points (a fraction of the cloud's points, labelled with their nearest point's
+    part) added to every augmented training cloud, a new draw every epoch
+    (:mod:`perception.corruption`); none by default, as in the paper."""
 
     model: CaptConfig = field(default_factory=CaptConfig)
     epochs: int = 50
@@ -171,6 +175,7 @@ class TrainConfig:
     augment: bool = True
     rotation_augmentation: Literal["so3", "yaw"] = "so3"
     val_pose: Literal["world", "yaw", "so3"] = "world"
+    sensor_noise: Corruption = field(default_factory=Corruption)
     train_split: str = "train"
     val_split: str = "val"
     max_train_samples: int | None = None

@@ -8,10 +8,12 @@ Two corruptions a depth camera produces, applied to one object cloud (world fram
   kept inside the box so that the bounding-box normalisation, and so the normalised frame, is the
   clean cloud's).
 
-The draw depends on the sample's split index alone (``np.random.default_rng([CORRUPTION_SEED, index])``),
-so every checkpoint scored in one run sees the same corrupted clouds and a paired comparison stays
-paired. The first ``n`` points of the result are the clean points (jittered) in their original order;
-outliers have no ground-truth part, so segmentation is scored on those first ``n`` only.
+For test clouds (:func:`corrupt_cloud`) the draw depends on the sample's split index alone
+(``np.random.default_rng([CORRUPTION_SEED, index])``), so every checkpoint scored in one run sees the same
+corrupted clouds and a paired comparison stays paired. The first ``n`` points of the result are the
+clean points (jittered) in their original order; outliers have no ground-truth part, so segmentation is
+scored on those first ``n`` only. For training (:func:`corrupt_points` with the epoch's generator, as
+``TrainConfig.sensor_noise`` does) the draw changes every epoch.
 """
 
 from __future__ import annotations
@@ -54,14 +56,19 @@ class Corruption:
 
 
 def corrupt_cloud(points: np.ndarray, index: int, corruption: Corruption) -> np.ndarray:
+    """Test cloud ``index``'s corruption: :func:`corrupt_points` with the index's fixed generator."""
+    return corrupt_points(points, np.random.default_rng([CORRUPTION_SEED, int(index)]), corruption)
+
+
+def corrupt_points(points: np.ndarray, rng: np.random.Generator, corruption: Corruption) -> np.ndarray:
     """``points`` (n, 3) metres -> (n + m, 3): the clean points jittered, then ``m`` outliers (see the
-    module docstring). A clean ``corruption`` returns the input unchanged (same object)."""
+    module docstring), drawn from ``rng``. A clean ``corruption`` returns the input unchanged (same
+    object) and draws nothing."""
     pts = np.asarray(points, np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) == 0:
         raise ValueError(f"points must have shape (n, 3) with n > 0, got {pts.shape}")
     if corruption.is_clean:
         return points
-    rng = np.random.default_rng([CORRUPTION_SEED, int(index)])
     noisy = pts + rng.normal(0.0, corruption.jitter_m, size=pts.shape) if corruption.jitter_m > 0 else pts
     m = int(round(corruption.outlier_fraction * len(pts)))
     if m == 0:

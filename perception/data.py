@@ -27,15 +27,16 @@ keys without the leading S axis (:meth:`Sample.save` / :meth:`Sample.load`).
 ``np.random.default_rng([seed, e, i])`` (different every epoch, reproducible): optional augmentation
 (rotation about x, y, z each uniform in [-pi, pi], translation uniform in [-1, 1]^3, scale uniform in
 [0.8, 1.2]; directions rotate, pivots rotate/scale/translate, prismatic states and limits scale,
-revolute states are unchanged), background removal, resampling to ``num_points``, normalisation to the
-object frame (:mod:`perception.normalisation`) and per-point targets (dist, pdir).
+revolute states are unchanged) and optional sensor noise (:func:`add_sensor_noise`), background removal,
+resampling to ``num_points``, normalisation to the object frame (:mod:`perception.normalisation`) and
+per-point targets (dist, pdir).
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +44,7 @@ import torch
 from torch.utils.data import Dataset
 
 from perception.config import JOINT_TYPE_CODES, ModelConfig
+from perception.corruption import Corruption, corrupt_points
 from perception.geometry import axis_targets
 from perception.normalisation import Normalisation
 
@@ -199,6 +201,25 @@ def augment(sample: Sample, rng: np.random.Generator, translation: float = 1.0,
     )
 
 
+def add_sensor_noise(sample: Sample, rng: np.random.Generator, noise: Corruption) -> Sample:
+    """``sample``'s object points (background dropped) with ``noise`` drawn from ``rng``
+    (:func:`perception.corruption.corrupt_points`); each stray point takes the part label of its
+    nearest object point. Joints are unchanged. A clean ``noise`` returns ``sample`` itself."""
+    if noise.is_clean:
+        return sample
+    from perception.inference import nearest_labels
+
+    labels = np.asarray(sample.part_labels, np.int64)
+    obj = labels >= 0
+    if not obj.any():
+        raise ValueError("sample has no object points")
+    pts = np.asarray(sample.points, np.float64)[obj]
+    noisy = corrupt_points(pts, rng, noise)
+    stray = noisy[len(pts):]
+    stray_labels = nearest_labels(stray, pts, labels[obj]) if len(stray) else np.empty(0, np.int64)
+    return replace(sample, points=noisy, part_labels=np.concatenate([labels[obj], stray_labels]))
+
+
 POSES = ("world", "yaw", "so3")
 POSE_SEED = 20240
 
@@ -258,12 +279,13 @@ def prepare_sample(sample: Sample, num_points: int, rng: np.random.Generator) ->
 class CaptShardDataset(Dataset):
     """A split of a shard directory as training tensors (see module docstring). ``max_samples`` keeps
     the first samples only. ``pose`` puts every sample in its fixed seeded pose first (see
-    :func:`posed_sample`; validation and test clouds), before any augmentation. Call
-    :meth:`set_epoch` each epoch to change the augmentation draw."""
+    :func:`posed_sample`; validation and test clouds), before any augmentation. ``sensor_noise`` is added
+    to augmented clouds only (:func:`add_sensor_noise`). Call :meth:`set_epoch` each epoch to change the
+    augmentation draw."""
 
     def __init__(self, data_dir: str | Path, split: str, model: ModelConfig, augment: bool = False,
                  seed: int = 0, max_samples: int | None = None, rotation: str = "so3",
-                 pose: str = "world") -> None:
+                 pose: str = "world", sensor_noise: Corruption | None = None) -> None:
         check_pose(pose)
         arrays = fit_joint_slots(load_split(data_dir, split), model.max_joints)
         if max_samples is not None:
@@ -273,6 +295,7 @@ class CaptShardDataset(Dataset):
         self.augment = augment
         self.rotation = rotation
         self.pose = pose
+        self.sensor_noise = sensor_noise or Corruption()
         self.seed = seed
         self.epoch = 0
         self._check(model)
@@ -305,7 +328,7 @@ class CaptShardDataset(Dataset):
         rng = np.random.default_rng([self.seed, self.epoch, int(index)])
         s = self.posed(index)
         if self.augment:
-            s = augment(s, rng, rotation=self.rotation)
+            s = add_sensor_noise(augment(s, rng, rotation=self.rotation), rng, self.sensor_noise)
         item = prepare_sample(s, self.num_points, rng)
         item["index"] = torch.tensor(int(index))
         return item

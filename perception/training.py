@@ -162,7 +162,7 @@ def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume
     mcfg = config.model.model
     train_ds = CaptShardDataset(data_dir, config.train_split, mcfg, augment=config.augment, seed=config.seed,
                                 rotation=config.rotation_augmentation,
-                                max_samples=config.max_train_samples)
+                                max_samples=config.max_train_samples, sensor_noise=config.sensor_noise)
     val_ds = CaptShardDataset(data_dir, config.val_split, mcfg, augment=False, seed=config.seed + 1,
                               max_samples=config.max_val_samples, pose=config.val_pose)
     category = str(train_ds.arrays["category"][0]) if len(train_ds) else ""

@@ -101,7 +101,12 @@ def from_dict(cls: type[T], data: Any, where: str = "config") -> T:
             f"{where}: unknown key(s) {unknown} for {cls.__name__}; known: {sorted(fields)}"
         )
     kwargs = {k: _convert(v, hints[k], f"{where}.{k}") for k, v in data.items()}
-    obj = cls(**kwargs)
+    try:
+        obj = cls(**kwargs)
+    except ConfigError:
+        raise
+    except ValueError as err:  # a dataclass that checks itself in __post_init__
+        raise ConfigError(f"{where}: {err}") from err
     validate = getattr(obj, "validate", None)
     if callable(validate):
         validate()

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# How the shipped checkpoints degrade on corrupted depth clouds, with and without double voting, and
+# what the statistical outlier filter buys back. Needs the four categories' data (`capt generate
+# --config configs/generate/<category>.yaml --out data/<category>`). Writes, per category and
+# condition, benchmarks/robustness/<category>_<condition>.{md,json} (`capt evaluate`), per condition
+# the mean over the categories with CAPT minus CAPT w/o DV and its paired 95% interval
+# (benchmarks/robustness/mean_<condition>.{md,json}, scripts/compare_variants.py), and the summary
+# table benchmarks/robustness/summary.{md,json} (scripts/robustness_table.py).
+#   bash scripts/robustness_sweep.sh [category ...]     (default: laptop oven washing_machine eyeglasses)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+categories=("${@:-laptop oven washing_machine eyeglasses}")
+read -r -a categories <<< "${categories[*]}"
+out=benchmarks/robustness
+mkdir -p "$out"
+# condition name -> capt evaluate options
+declare -A conditions=(
+  [clean]=""
+  [jitter2mm]="--test-jitter 0.002"
+  [jitter5mm]="--test-jitter 0.005"
+  [outliers5]="--test-outliers 0.05"
+  [outliers20]="--test-outliers 0.2"
+  [clean_filtered]="--filter-outliers"
+  [outliers5_filtered]="--test-outliers 0.05 --filter-outliers"
+  [outliers20_filtered]="--test-outliers 0.2 --filter-outliers"
+)
+order=(clean jitter2mm jitter5mm outliers5 outliers20 clean_filtered outliers5_filtered outliers20_filtered)
+for cond in "${order[@]}"; do
+  files=()
+  for cat in "${categories[@]}"; do
+    # shellcheck disable=SC2086  # the options are meant to split
+    .venv/bin/capt evaluate "perception/checkpoints/$cat.pt" --data "data/$cat" --split test \
+      --without-double-voting --timing-clouds 1 ${conditions[$cond]} \
+      --markdown "$out/${cat}_$cond.md" --json "$out/${cat}_$cond.json" > /dev/null
+    files+=("$out/${cat}_$cond.json")
+  done
+  .venv/bin/python scripts/compare_variants.py "${files[@]}" \
+    --markdown "$out/mean_$cond.md" --json "$out/mean_$cond.json" > /dev/null
+  echo "done: $cond"
+done
+means=()
+for cond in "${order[@]}"; do means+=("$out/mean_$cond.json"); done
+.venv/bin/python scripts/robustness_table.py "${means[@]}" --markdown "$out/summary.md" --json "$out/summary.json"
