@@ -76,6 +76,7 @@ def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg
 
 
 WITHOUT_DV = "capt_without_dv"
+WARM_UP_CALLS = 3
 
 
 def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str = "test",
@@ -88,8 +89,8 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
     checkpoints compared), so no row overwrites another. ``without_double_voting`` also scores every
     CAPT checkpoint with the coarse vote only, as method ``capt_without_dv`` (the paper's "CAPT w/o
     DV": the motion loss's training without double voting's inference). Timing is the median of
-    ``predict`` latency over at least ``timing_clouds`` single-cloud calls (cycling over the split if it
-    is smaller), after 3 warm-up calls, on the clouds as scored. ``test_pose``, ``corruption`` and
+    ``predict`` latency over the scored single-cloud calls, after 3 warm-up calls, and more calls
+    (cycling over the split) until there are at least ``timing_clouds``. ``test_pose``, ``corruption`` and
     ``outlier_filter``: see the module docstring."""
     check_pose(test_pose, "test_pose")
     if len({str(p) for p in checkpoints}) != len(checkpoints):
@@ -116,15 +117,16 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
         samples = [ds.posed(i) for i in range(len(ds))]
         clean = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]
         clouds = [corrupt_cloud(c, i, corruption) for i, c in enumerate(clean)] if corruption else clean
+        for c in clouds[:WARM_UP_CALLS]:
+            est.predict(c)
+        times = []
         for s, n, cloud in tqdm(list(zip(samples, map(len, clean), clouds, strict=True)),
                                 desc=f"evaluate {method}", disable=not progress):
             pred = est.predict(cloud)
+            times.append(pred.latency_ms)
             if len(cloud) > n:  # stray points appended by the corruption have no true part
                 pred = replace(pred, part_labels=pred.part_labels[:n])
             results.append(score_sample(pred, s, method, cfg.has_segmentation))
-        for c in clouds[:3]:
-            est.predict(c)
-        count = max(timing_clouds, len(clouds))
-        times = [est.predict(clouds[i % len(clouds)]).latency_ms for i in range(count)]
+        times += [est.predict(clouds[i % len(clouds)]).latency_ms for i in range(timing_clouds - len(times))]
         median_ms[method] = statistics.median(times)
     return EvaluationResult(results, median_ms, table_markdown(results))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from unittest import mock
 
 import pytest
 
@@ -12,6 +13,7 @@ from perception.config import CaptConfig, TrainConfig
 from perception.corruption import Corruption
 from perception.data import write_dataset
 from perception.evaluation import evaluate
+from perception.inference import ArticulationEstimator
 from perception.outlier_filter import OutlierFilter
 from perception.training import train
 
@@ -51,7 +53,11 @@ def test_train_resume_and_evaluate(tmp_path, data_dir):
     assert all((a[k].float() - b[k].float()).abs().max() < 1e-5 for k in a)
 
     plain = train(_cfg("pct_regression", 1), data_dir, tmp_path / "pct")
-    ev = evaluate([resumed.best_path, plain.best_path], data_dir, "test", timing_clouds=5, progress=False)
+    spy = mock.patch.object(ArticulationEstimator, "predict", autospec=True,
+                            side_effect=ArticulationEstimator.predict)
+    with spy as calls:
+        ev = evaluate([resumed.best_path, plain.best_path], data_dir, "test", timing_clouds=5, progress=False)
+    assert calls.call_count == 2 * (3 + 4 + 1)  # per checkpoint: 3 warm-up, 4 scored and timed, 1 more timed
     assert len(ev.results) == 8 and set(ev.median_ms) == {"capt", "pct_regression"}
     assert all(r.joints and 0 <= r.joints[0].direction_error_deg <= 180 for r in ev.results)
     assert all(r.pa is not None for r in ev.results if r.method == "capt")
