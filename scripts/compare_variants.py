@@ -28,6 +28,7 @@ which objects are in the test split. ``--methods`` reads only the listed methods
 from __future__ import annotations
 
 import argparse
+import gzip
 import json
 import statistics
 from pathlib import Path
@@ -61,6 +62,15 @@ def category_errors(s: dict) -> dict[str, float | None]:
             "state_m": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if not r])}
 
 
+def read_run(path: Path) -> dict:
+    """A ``capt evaluate --json`` file, plain or gzip-compressed (``.json.gz``, as kept in
+    ``benchmarks/robustness/``)."""
+    if path.suffix == ".gz":
+        with gzip.open(path, "rt") as fh:
+            return json.load(fh)
+    return json.loads(path.read_text())
+
+
 def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed: int = 0,
             resample: str = "clouds", only: list[str] | None = None) -> dict:
     """{"methods": [...], "categories": {cat: {method: {metric: value}}}, "mean": {method: {...}},
@@ -82,7 +92,7 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     poses: dict[str, list[str]] = {}
     corruptions: dict[str, list[str]] = {}
     for index, path in enumerate(paths):
-        run = json.loads(path.read_text())
+        run = read_run(path)
         poses.setdefault(run.get("test_pose", "world"), []).append(str(path))
         corruption = json.dumps({"test_corruption": run.get("test_corruption", CLEAN),
                                  "outlier_filter": run.get("outlier_filter")}, sort_keys=True)
@@ -155,7 +165,7 @@ def _gap(d: dict) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("inputs", nargs="+", type=Path, help="capt evaluate --json files")
+    parser.add_argument("inputs", nargs="+", type=Path, help="capt evaluate --json files (.json or .json.gz)")
     parser.add_argument("--markdown", type=Path, default=None)
     parser.add_argument("--json", type=Path, default=None)
     parser.add_argument("--reference", default="capt",

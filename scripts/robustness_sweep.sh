@@ -2,7 +2,7 @@
 # How the shipped checkpoints degrade on corrupted depth clouds, with and without double voting, and
 # what the statistical outlier filter buys back. Needs the four categories' data (`capt generate
 # --config configs/generate/<category>.yaml --out data/<category>`). Writes, per category and
-# condition, benchmarks/robustness/<category>_<condition>.{md,json} (`capt evaluate`), per condition
+# condition, benchmarks/robustness/<category>_<condition>.{md,json.gz} (`capt evaluate`), per condition
 # the mean over the categories with CAPT minus CAPT w/o DV and its paired 95% interval
 # (benchmarks/robustness/mean_<condition>.{md,json}, scripts/compare_variants.py), and the summary
 # table benchmarks/robustness/summary.{md,json} (scripts/robustness_table.py).
@@ -36,6 +36,7 @@ for cond in "${order[@]}"; do
   done
   .venv/bin/python scripts/compare_variants.py "${files[@]}" \
     --markdown "$out/mean_$cond.md" --json "$out/mean_$cond.json" > /dev/null
+  gzip -f "${files[@]}"  # the per-cloud files are kept compressed (compare_variants.py reads .json.gz)
   echo "done: $cond"
 done
 means=()

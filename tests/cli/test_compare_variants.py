@@ -141,6 +141,17 @@ def test_runs_scored_with_different_test_corruptions_are_refused(tmp_path, load_
     assert cv.compare([filtered], draws=10)["outlier_filter"] == {"neighbours": 8, "std_ratio": 3.0}
 
 
+def test_gzip_compressed_runs_read_as_plain_ones(tmp_path, load_script):
+    import gzip
+
+    cv = load_script("compare_variants")
+    plain = _run_file(tmp_path / "run.json", {"capt": 1.0, "capt_plain": 0.0}, n=20)
+    packed = tmp_path / "packed.json.gz"
+    packed.write_bytes(gzip.compress(plain.read_bytes()))
+    a, b = cv.compare([plain], draws=50), cv.compare([packed], draws=50)
+    assert a["mean"] == b["mean"] and a["paired"] == b["paired"]
+
+
 def test_a_missing_input_file_is_named(tmp_path, monkeypatch, capsys, load_script):
     cv = load_script("compare_variants")
     present = _run_file(tmp_path / "seed0.json", {"capt": 1.0, "capt_plain": 0.0})
