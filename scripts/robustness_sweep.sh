@@ -7,6 +7,7 @@
 # (benchmarks/robustness/mean_<condition>.{md,json}, scripts/compare_variants.py), and the summary
 # table benchmarks/robustness/summary.{md,json} (scripts/robustness_table.py).
 #   bash scripts/robustness_sweep.sh [category ...]     (default: laptop oven washing_machine eyeglasses)
+# CONDITIONS="clean outliers5" runs only those conditions (the summary still reads every mean_ file).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 categories=("${@:-laptop oven washing_machine eyeglasses}")
@@ -23,9 +24,15 @@ declare -A conditions=(
   [clean_filtered]="--filter-outliers"
   [outliers5_filtered]="--test-outliers 0.05 --filter-outliers"
   [outliers20_filtered]="--test-outliers 0.2 --filter-outliers"
+  [clean_filtered_r5]="--filter-outliers --filter-std-ratio 5"
+  [outliers5_filtered_r5]="--test-outliers 0.05 --filter-outliers --filter-std-ratio 5"
+  [outliers20_filtered_r5]="--test-outliers 0.2 --filter-outliers --filter-std-ratio 5"
 )
-order=(clean jitter2mm jitter5mm outliers5 outliers20 clean_filtered outliers5_filtered outliers20_filtered)
-for cond in "${order[@]}"; do
+order=(clean jitter2mm jitter5mm outliers5 outliers20 clean_filtered outliers5_filtered outliers20_filtered
+       clean_filtered_r5 outliers5_filtered_r5 outliers20_filtered_r5)
+read -r -a run <<< "${CONDITIONS:-${order[*]}}"
+for cond in "${run[@]}"; do
+  [[ -v "conditions[$cond]" ]] || { echo "unknown condition: $cond (known: ${order[*]})" >&2; exit 2; }
   files=()
   for cat in "${categories[@]}"; do
     # shellcheck disable=SC2086  # the options are meant to split
@@ -40,5 +47,7 @@ for cond in "${order[@]}"; do
   echo "done: $cond"
 done
 means=()
-for cond in "${order[@]}"; do means+=("$out/mean_$cond.json"); done
+for cond in "${order[@]}"; do
+  if [[ -f "$out/mean_$cond.json" ]]; then means+=("$out/mean_$cond.json"); fi
+done
 .venv/bin/python scripts/robustness_table.py "${means[@]}" --markdown "$out/summary.md" --json "$out/summary.json"
