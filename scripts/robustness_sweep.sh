@@ -8,11 +8,15 @@
 # table benchmarks/robustness/summary.{md,json} (scripts/robustness_table.py).
 #   bash scripts/robustness_sweep.sh [category ...]     (default: laptop oven washing_machine eyeglasses)
 # CONDITIONS="clean outliers5" runs only those conditions (the summary still reads every mean_ file).
+# CHECKPOINTS="runs/{category}/capt_seed3/best.pt runs/{category}/capt_plain_seed3/best.pt" scores
+# those checkpoints side by side instead of the shipped one ({category} is replaced per category), and
+# OUT=benchmarks/robustness/variants_seed3 writes there instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 categories=("${@:-laptop oven washing_machine eyeglasses}")
 read -r -a categories <<< "${categories[*]}"
-out=benchmarks/robustness
+out=${OUT:-benchmarks/robustness}
+read -r -a checkpoint_patterns <<< "${CHECKPOINTS:-perception/checkpoints/{category\}.pt}"
 mkdir -p "$out"
 # condition name -> capt evaluate options
 declare -A conditions=(
@@ -35,8 +39,9 @@ for cond in "${run[@]}"; do
   [[ -v "conditions[$cond]" ]] || { echo "unknown condition: $cond (known: ${order[*]})" >&2; exit 2; }
   files=()
   for cat in "${categories[@]}"; do
+    checkpoints=("${checkpoint_patterns[@]//\{category\}/$cat}")
     # shellcheck disable=SC2086  # the options are meant to split
-    .venv/bin/capt evaluate "perception/checkpoints/$cat.pt" --data "data/$cat" --split test \
+    .venv/bin/capt evaluate "${checkpoints[@]}" --data "data/$cat" --split test \
       --without-double-voting --timing-clouds 1 ${conditions[$cond]} \
       --markdown "$out/${cat}_$cond.md" --json "$out/${cat}_$cond.json" > /dev/null
     files+=("$out/${cat}_$cond.json")

@@ -11,7 +11,7 @@ from __future__ import annotations
 from capt_env.objects.geometry import opening_axis
 from capt_env.objects.parts import BODY_WHITES, GLASS, METALS, bar_handle, box_from_bounds, open_carcass
 from capt_env.objects.sampling import ParamSampler
-from capt_env.objects.spec import JointSpec, LinkSpec, ObjectSpec
+from capt_env.objects.spec import JointSpec, LinkSpec, ObjectSpec, hinged_door_object
 
 CATEGORY = "oven"
 
@@ -91,13 +91,4 @@ def make(instance_id: int) -> ObjectSpec:
         damping=2.0,
         friction=0.2,
     )
-    return ObjectSpec(
-        CATEGORY,
-        instance_id,
-        (LinkSpec("body", tuple(body), density=400.0), door),
-        (hinge,),
-        target_joint="door_hinge",
-        grasp_link="door",
-        grasp_point=grasp,
-        params=s.params,
-    )
+    return hinged_door_object(CATEGORY, instance_id, body, door, hinge, grasp, s.params)

@@ -13,6 +13,7 @@ closed/folded pose of the category. Limits are (lower, upper) with lower <= 0 <=
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -98,3 +99,23 @@ class ObjectSpec:
 
         pts = np.concatenate([box_corners(b) for link in self.links for b in link.boxes])
         return pts.min(axis=0), pts.max(axis=0)
+
+
+def hinged_door_object(category: str, instance_id: int, body: Iterable[Box], door: LinkSpec, hinge: JointSpec,
+                       grasp_point: tuple[float, float, float], params: dict) -> ObjectSpec:
+    """An instance made of a fixed body (``body`` boxes, 400 kg/m^3) and one ``door`` link on the
+    revolute joint ``hinge`` (body to door), which is the target; ``grasp_point`` is in the door's
+    frame, metres (an oven, a washing machine, a cabinet door)."""
+    if hinge.parent != "body" or hinge.child != door.name:
+        raise ValueError(f"the hinge must join 'body' to {door.name!r}, "
+                         f"got {hinge.parent!r} -> {hinge.child!r}")
+    return ObjectSpec(
+        category,
+        instance_id,
+        (LinkSpec("body", tuple(body), density=400.0), door),
+        (hinge,),
+        target_joint=hinge.name,
+        grasp_link=door.name,
+        grasp_point=grasp_point,
+        params=params,
+    )

@@ -23,7 +23,7 @@ from capt_env.objects.parts import (
     open_carcass,
 )
 from capt_env.objects.sampling import ParamSampler
-from capt_env.objects.spec import Box, JointSpec, LinkSpec, ObjectSpec
+from capt_env.objects.spec import Box, JointSpec, LinkSpec, ObjectSpec, hinged_door_object
 
 CATEGORY = "washing_machine"
 
@@ -119,13 +119,4 @@ def make(instance_id: int) -> ObjectSpec:
         damping=1.0,
         friction=0.04,
     )
-    return ObjectSpec(
-        CATEGORY,
-        instance_id,
-        (LinkSpec("body", tuple(body), density=400.0), door),
-        (hinge,),
-        target_joint="door_hinge",
-        grasp_link="door",
-        grasp_point=grasp,
-        params=s.params,
-    )
+    return hinged_door_object(CATEGORY, instance_id, body, door, hinge, grasp, s.params)

@@ -127,3 +127,20 @@ def test_unknown_category_error_names_known_ones() -> None:
 def test_bad_instance_id(bad) -> None:
     with pytest.raises(ValueError, match="instance_id"):
         make_object("laptop", bad)
+
+
+@pytest.mark.parametrize("category", ["oven", "washing_machine", "cabinet_door"])
+def test_hinged_door_objects_target_their_door(category: str) -> None:
+    spec = make_object(category, 5)
+    assert [link.name for link in spec.links] == ["body", "door"]
+    assert spec.links[0].density == 400.0
+    assert (spec.target_joint, spec.grasp_link) == ("door_hinge", "door")
+
+
+def test_hinged_door_object_refuses_a_hinge_on_another_link() -> None:
+    from capt_env.objects.spec import Box, JointSpec, LinkSpec, hinged_door_object
+
+    door = LinkSpec("door", (Box((0.1, 0.1, 0.01)),))
+    hinge = JointSpec("door_hinge", "revolute", "body", "lid", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, 1.5))
+    with pytest.raises(ValueError, match="'body' to 'door', got 'body' -> 'lid'"):
+        hinged_door_object("oven", 0, [Box((0.2, 0.2, 0.2))], door, hinge, (0.0, 0.0, 0.0), {})
