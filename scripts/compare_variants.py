@@ -9,7 +9,9 @@ categories, the mean direction error (degrees), position error (normalised objec
 error, in degrees over revolute joints and in metres over prismatic ones (never averaged together),
 each first averaged over the category's joints. A joint without a position error is prismatic
 (``capt evaluate`` reports none for them). A mean over no value (e.g. position when every category
-is prismatic) is "-".
+is prismatic) is "-". The means table also gives the share of axes pointing the wrong way (direction
+error over 90 degrees, ``capt evaluate``'s ``dir_flipped``), as a few sign flips can carry a
+mean direction error.
 
 Then, for every method beside the reference (``--reference``, default ``capt``), the paired gap
 reference minus method on each category and on the mean, with a 95% bootstrap interval over the test
@@ -40,10 +42,17 @@ from perception.paired_comparison import RESAMPLE_UNITS, PairedDifference, paire
 # (key, column label); the keys are perception.paired_comparison's, in its order
 METRICS = tuple(zip(PAIRED_METRICS, ("direction (deg)", "position (normalised)", "state, revolute (deg)",
                                      "state, prismatic (m)"), strict=True))
+# the means table's columns: the paired metrics, then the share of axes pointing the wrong way (a
+# direction error over 90 degrees, `capt evaluate`'s dir_flipped), which has no paired gap
+COLUMNS = (*METRICS, ("dir_flipped", "direction flipped (share)"))
 # what a `capt evaluate --json` file without "test_corruption" (older than the key) was scored with
 CLEAN = {"jitter_m": 0.0, "outlier_fraction": 0.0}
-TABLE_HEAD = ["| category | method | " + " | ".join(label for _, label in METRICS) + " |",
-              "|" + " --- |" * (len(METRICS) + 2)]
+
+
+def table_head(columns: tuple[tuple[str, str], ...]) -> list[str]:
+    """A Markdown table's header lines for a category and a method column, then ``columns``."""
+    return ["| category | method | " + " | ".join(label for _, label in columns) + " |",
+            "|" + " --- |" * (len(columns) + 2)]
 
 
 def joint_mean(values: list[float | None]) -> float | None:
@@ -55,11 +64,13 @@ def joint_mean(values: list[float | None]) -> float | None:
 
 def category_errors(s: dict) -> dict[str, float | None]:
     """One method's joint means on one category from its ``capt evaluate`` summary ``s``; the state
-    is split by joint type (a joint with no position error is prismatic)."""
+    is split by joint type (a joint with no position error is prismatic). ``dir_flipped`` is None for
+    a summary older than it."""
     revolute = [p is not None for p in s["pos_aed"]]
     return {"dir_med": joint_mean(s["dir_med"]), "pos_aed": joint_mean(s["pos_aed"]),
             "state_deg": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if r]),
-            "state_m": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if not r])}
+            "state_m": joint_mean([v for v, r in zip(s["state_med"], revolute, strict=True) if not r]),
+            "dir_flipped": joint_mean(s.get("dir_flipped", []))}
 
 
 def read_run(path: Path) -> dict:
@@ -112,12 +123,12 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     absent = sorted(set(only or ()) - seen)
     if absent:
         raise ValueError(f"no input scored the method(s) {absent}; they hold {sorted(seen)}")
-    per_cat = {c: {m: {k: joint_mean([r[k] for r in runs]) for k, _ in METRICS} for m, runs in by_m.items()}
+    per_cat = {c: {m: {k: joint_mean([r[k] for r in runs]) for k, _ in COLUMNS} for m, runs in by_m.items()}
                for c, by_m in per_run.items()}
     methods = sorted(set.intersection(*(set(v) for v in per_cat.values())))
     if not methods:
         raise SystemExit("no method was evaluated on every category")
-    mean = {m: {k: joint_mean([per_cat[c][m][k] for c in per_cat]) for k, _ in METRICS}
+    mean = {m: {k: joint_mean([per_cat[c][m][k] for c in per_cat]) for k, _ in COLUMNS}
             for m in methods}
     paired: dict = {}
     if draws > 0 and any(x["method"] == reference for x in samples):
@@ -136,12 +147,12 @@ def _as_dict(d: PairedDifference | None) -> dict | None:
 
 
 def markdown(result: dict) -> str:
-    lines = list(TABLE_HEAD)
+    lines = table_head(COLUMNS)
     rows = [*((c, result["categories"][c]) for c in sorted(result["categories"])), ("mean", result["mean"])]
     runs = result.get("runs", {})
     for cat, by_method in rows:
         for m in result["methods"]:
-            cells = ["-" if by_method[m][k] is None else f"{by_method[m][k]:.4g}" for k, _ in METRICS]
+            cells = ["-" if by_method[m].get(k) is None else f"{by_method[m][k]:.4g}" for k, _ in COLUMNS]
             n = runs.get(cat, {}).get(m, 1)
             label = f"{m} (mean of {n} runs)" if n > 1 else m
             lines.append(f"| {cat} | {label} | " + " | ".join(cells) + " |")
@@ -151,7 +162,7 @@ def markdown(result: dict) -> str:
                 if result.get("resample") == "instances" else "the test clouds")
         lines += ["", f"{ref} minus each method, with a 95% paired bootstrap interval over {unit} "
                   f"({result['draws']} draws, seed {result['seed']}; negative: {ref} has the lower "
-                  "error):", "", *TABLE_HEAD]
+                  "error):", "", *table_head(METRICS)]
         for other, rows in result["paired"].items():
             for cat in [*sorted(c for c in rows if c != "mean"), "mean"]:
                 cells = ["-" if rows[cat][k] is None else _gap(rows[cat][k]) for k, _ in METRICS]

@@ -2,7 +2,8 @@
 `scripts/compare_variants.py --json` files (one per condition, each the mean over the same categories).
 
 A row per condition and method: the mean direction error (degrees), position error (normalised object
-frame) and revolute state error (degrees) over the categories, and, for every method beside the
+frame) and revolute state error (degrees) over the categories, the share of axes pointing the wrong way
+(direction error over 90 degrees; "-" in files older than it), and, for every method beside the
 reference, the reference's paired gap (reference minus method) with its 95% bootstrap interval over the
 test clouds. The condition's name is the file's stem less a leading ``mean_``; its corruption and
 outlier filter are read from the file.
@@ -43,6 +44,7 @@ def rows(paths: list[Path]) -> list[dict]:
             out.append({"condition": condition_name(path), "corruption": result.get("test_corruption"),
                         "outlier_filter": result.get("outlier_filter"), "method": method,
                         "reference": reference, **{k: result["mean"][method][k] for k, _, _ in METRICS},
+                        "dir_flipped": result["mean"][method].get("dir_flipped"),
                         "gap": gap})
     return out
 
@@ -58,12 +60,13 @@ def _gap_cell(gap: dict | None, fmt: str) -> str:
 
 
 def markdown(table: list[dict]) -> str:
-    head = (["condition", "method"] + [label for _, label, _ in METRICS]
+    head = (["condition", "method"] + [label for _, label, _ in METRICS] + ["direction flipped (share)"]
             + [f"reference minus method, {label}" for _, label, _ in METRICS])
     lines = ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
     for r in table:
         gaps = [_gap_cell(None if r["gap"] is None else r["gap"][k], f) for k, _, f in METRICS]
-        cells = [r["condition"], r["method"], *(_cell(r[k], f) for k, _, f in METRICS), *gaps]
+        cells = [r["condition"], r["method"], *(_cell(r[k], f) for k, _, f in METRICS),
+                 _cell(r["dir_flipped"], ".3f"), *gaps]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 

@@ -37,6 +37,25 @@ def test_means_over_joints_then_categories(tmp_path, load_script):
     assert "| drawer_cabinet | capt | 6 | - | - | 0.03 |" in table
 
 
+def test_share_of_flipped_axes_is_averaged_like_the_errors(tmp_path, load_script):
+    """``dir_flipped`` (axes over 90 degrees off) is meaned over joints, runs and categories, and shown
+    as the means table's last column; a file older than it leaves the cell empty."""
+    cv = load_script("compare_variants")
+    a = _write(tmp_path / "a.json", "eyeglasses", {
+        "capt": {"dir_med": [1.0, 3.0], "pos_aed": [0.02, 0.04], "state_med": [4.0, 6.0],
+                 "dir_flipped": [0.0, 0.1]}})
+    b = _write(tmp_path / "b.json", "laptop", {
+        "capt": {"dir_med": [2.0], "pos_aed": [0.01], "state_med": [3.0], "dir_flipped": [0.25]}})
+    result = cv.compare([a, b])
+    assert result["categories"]["eyeglasses"]["capt"]["dir_flipped"] == pytest.approx(0.05)
+    assert result["mean"]["capt"]["dir_flipped"] == pytest.approx(0.15)
+    assert "| mean | capt | 2 | 0.02 | 4 | - | 0.15 |" in cv.markdown(result)
+    old = _write(tmp_path / "old.json", "oven", {
+        "capt": {"dir_med": [2.0], "pos_aed": [0.01], "state_med": [3.0]}})
+    assert cv.compare([old])["mean"]["capt"]["dir_flipped"] is None
+    assert "| mean | capt | 2 | 0.01 | 3 | - | - |" in cv.markdown(cv.compare([old]))
+
+
 def test_a_category_with_both_joint_types_and_an_all_prismatic_set(tmp_path, load_script):
     cv = load_script("compare_variants")
     mixed = _write(tmp_path / "m.json", "kitchen", {

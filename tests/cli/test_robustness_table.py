@@ -15,8 +15,9 @@ def _mean_file(path: Path, load_script, offset: float, corruption: dict | None =
     samples = [{"category": "laptop", "method": m, "joints": [
         {"joint_index": 0, "joint_type": "revolute", "direction_error_deg": i + off, "position_error": 0.01,
          "state_error": 3.0}]} for i in range(20) for m, off in (("capt", offset), ("capt_without_dv", 0.0))]
-    summary = {m: {"laptop": {"dir_med": [9.5 + off], "pos_aed": [0.01], "state_med": [3.0]}}
-               for m, off in (("capt", offset), ("capt_without_dv", 0.0))}
+    summary = {m: {"laptop": {"dir_med": [9.5 + off], "pos_aed": [0.01], "state_med": [3.0],
+                              "dir_flipped": [flipped]}}
+               for m, off, flipped in (("capt", offset, 0.05), ("capt_without_dv", 0.0, 0.1))}
     run = {"summary": summary, "samples": samples}
     if corruption:
         run["test_corruption"] = corruption
@@ -40,4 +41,5 @@ def test_rows_and_table(tmp_path, load_script):
     assert gap["difference"] == pytest.approx(-2.5) and gap["low"] == pytest.approx(-2.5)
     assert rows[3]["corruption"] == {"jitter_m": 0.0, "outlier_fraction": 0.2}
     table = rt.markdown(rows)
-    assert "| outliers20 | capt_without_dv | 9.50 | 0.0100 | 3.00 | -2.50 [-2.50, -2.50] |" in table
+    assert rows[3]["dir_flipped"] == pytest.approx(0.1)
+    assert "| outliers20 | capt_without_dv | 9.50 | 0.0100 | 3.00 | 0.100 | -2.50 [-2.50, -2.50] |" in table
