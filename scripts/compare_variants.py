@@ -152,7 +152,7 @@ def markdown(result: dict) -> str:
     runs = result.get("runs", {})
     for cat, by_method in rows:
         for m in result["methods"]:
-            cells = ["-" if by_method[m].get(k) is None else f"{by_method[m][k]:.4g}" for k, _ in COLUMNS]
+            cells = ["-" if by_method[m][k] is None else f"{by_method[m][k]:.4g}" for k, _ in COLUMNS]
             n = runs.get(cat, {}).get(m, 1)
             label = f"{m} (mean of {n} runs)" if n > 1 else m
             lines.append(f"| {cat} | {label} | " + " | ".join(cells) + " |")
