@@ -20,7 +20,11 @@ has the lower error, and an interval that excludes 0 means the gap is more than 
 clouds are in the test split (it does not measure training noise). ``--resample instances`` draws
 the test instances instead, with all their views (needs the samples' ``instance_id``): the luck of
 which objects are in the test split. ``--methods`` reads only the listed methods from the files
-(e.g. a seed's file that also scored ``capt_without_dv``).
+(e.g. a seed's file that also scored ``capt_without_dv``). ``--rename PATTERN=NAME`` names the
+methods matching a shell-style pattern, before ``--methods`` reads them: two checkpoints of one
+variant scored in one run are named by ``capt evaluate`` after their paths
+(``capt (runs/laptop/capt_seed3/best.pt)``), so ``--rename 'capt (*capt_seed*)=capt'`` makes
+every seed's file name them alike.
 
     .venv/bin/python scripts/compare_variants.py benchmarks/perception_laptop.json \
         benchmarks/perception_oven.json --markdown benchmarks/variants_mean.md \
@@ -30,9 +34,11 @@ which objects are in the test split. ``--methods`` reads only the listed methods
 from __future__ import annotations
 
 import argparse
+import fnmatch
 import gzip
 import json
 import statistics
+from collections.abc import Callable
 from pathlib import Path
 
 from capt_env.commands.json_output import script_command, write_json, write_markdown
@@ -82,8 +88,25 @@ def read_run(path: Path) -> dict:
     return json.loads(path.read_text())
 
 
+def renamer(rules: list[tuple[str, str]] | None) -> Callable[[str], str]:
+    """A function naming a method by the first ``(pattern, name)`` rule whose shell-style pattern
+    matches it (``fnmatch``, case-sensitive); a name no rule matches is kept."""
+    def name(method: str) -> str:
+        return next((new for pattern, new in rules or () if fnmatch.fnmatchcase(method, pattern)), method)
+    return name
+
+
+def parse_rename(rule: str) -> tuple[str, str]:
+    """``"PATTERN=NAME"`` -> ``(PATTERN, NAME)``; the last ``=`` splits (a pattern may hold one)."""
+    pattern, sep, name = rule.rpartition("=")
+    if not sep or not pattern or not name:
+        raise ValueError(f"a --rename rule is PATTERN=NAME, got {rule!r}")
+    return pattern, name
+
+
 def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed: int = 0,
-            resample: str = "clouds", only: list[str] | None = None) -> dict:
+            resample: str = "clouds", only: list[str] | None = None,
+            rename: list[tuple[str, str]] | None = None) -> dict:
     """{"methods": [...], "categories": {cat: {method: {metric: value}}}, "mean": {method: {...}},
     "runs": {cat: {method: number of runs averaged}},
     "paired": {method: {cat or "mean": {metric: {difference, low, high, reference_lower_share}}}}}.
@@ -92,7 +115,9 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     out a row one of several runs also scored); a listed method no file holds is a ValueError, and so
     are files scored in different test poses (``capt evaluate --test-pose``; absent means world) or
     with different sensor corruptions (``--test-jitter``, ``--test-outliers``; absent means none) or
-    outlier filters (``--filter-outliers``; absent means none)."""
+    outlier filters (``--filter-outliers``; absent means none). ``rename``: ``(pattern, name)`` rules
+    applied to every method name before ``only`` (see :func:`renamer`); two methods of one file given
+    one name is a ValueError."""
     per_run: dict[str, dict[str, list[dict[str, float | None]]]] = {}
     samples: list[dict] = []
     seen: set[str] = set()
@@ -100,16 +125,25 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
     def keep(method: str) -> bool:
         return only is None or method in only
 
+    name = renamer(rename)
+
     poses: dict[str, list[str]] = {}
     corruptions: dict[str, list[str]] = {}
     for index, path in enumerate(paths):
         run = read_run(path)
+        names = [name(m) for m in run["summary"]]
+        clash = sorted({n for n in names if names.count(n) > 1})
+        if clash:
+            raise ValueError(f"{path}: --rename gives two of its methods the name(s) {clash}: "
+                             f"{sorted(run['summary'])}")
+        run["summary"] = {name(m): v for m, v in run["summary"].items()}
         poses.setdefault(run.get("test_pose", "world"), []).append(str(path))
         corruption = json.dumps({"test_corruption": run.get("test_corruption", CLEAN),
                                  "outlier_filter": run.get("outlier_filter")}, sort_keys=True)
         corruptions.setdefault(corruption, []).append(str(path))
         seen.update(run["summary"])
-        samples.extend({**s, "run": index} for s in run.get("samples", []) if keep(s["method"]))
+        renamed = ({**s, "method": name(s["method"])} for s in run.get("samples", []))
+        samples.extend({**s, "run": index} for s in renamed if keep(s["method"]))
         for method, cats in run["summary"].items():
             if not keep(method):
                 continue
@@ -135,7 +169,7 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
         paired = {m: {c: {k: _as_dict(d) for k, d in by_metric.items()} for c, by_metric in rows.items()}
                   for m, rows in paired_differences(samples, reference, draws, seed, resample).items()}
     return {"methods": methods, "categories": per_cat, "mean": mean, "inputs": [str(p) for p in paths],
-            "only": only, "test_pose": next(iter(poses)),
+            "only": only, "rename": [list(r) for r in rename or ()], "test_pose": next(iter(poses)),
             **json.loads(next(iter(corruptions))),
             "reference": reference, "draws": draws, "seed": seed, "resample": resample, "paired": paired,
             "runs": {c: {m: len(runs) for m, runs in by_m.items()} for c, by_m in per_run.items()}}
@@ -188,6 +222,9 @@ def main() -> None:
     parser.add_argument("--resample", choices=RESAMPLE_UNITS, default="clouds",
                         help="what a bootstrap draw resamples: test clouds, or test instances with all "
                              "their views (needs instance ids in the files)")
+    parser.add_argument("--rename", action="append", default=None, metavar="PATTERN=NAME",
+                        help="name the methods matching a shell-style pattern (repeatable; the first "
+                             "matching rule wins), e.g. 'capt (*capt_seed*)=capt'")
     args = parser.parse_args()
     if args.draws < 0:
         parser.error(f"--draws must be >= 0, got {args.draws}")
@@ -199,7 +236,9 @@ def main() -> None:
     if twice:
         parser.error(f"an input is given twice (it would count as two training runs): {', '.join(twice)}")
     try:
-        result = compare(args.inputs, args.reference, args.draws, args.seed, args.resample, args.methods)
+        rename = [parse_rename(r) for r in args.rename or ()]
+        result = compare(args.inputs, args.reference, args.draws, args.seed, args.resample, args.methods,
+                         rename)
     except ValueError as err:
         parser.error(str(err))
     table = markdown(result)

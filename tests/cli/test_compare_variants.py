@@ -224,6 +224,28 @@ def test_methods_reads_only_the_listed_rows(tmp_path, load_script):
         cv.compare([seed0], draws=0, only=["capt", "pct_regression"])
 
 
+def test_rename_pools_checkpoints_named_after_their_paths(tmp_path, load_script):
+    """Two CAPT checkpoints scored in one run carry their paths in the method name; --rename gives
+    each seed's pair the same two names, so the seeds average as runs of one method, and the paired
+    gap pairs the renamed rows cloud by cloud."""
+    cv = load_script("compare_variants")
+    seed2 = _run_file(tmp_path / "seed2.json", {"capt (runs/laptop/capt_seed2/best.pt)": 1.0,
+                                                 "capt (runs/laptop/capt_motion1_seed2/best.pt)": 0.0})
+    seed3 = _run_file(tmp_path / "seed3.json", {"capt (runs/laptop/capt_seed3/best.pt)": 0.0,
+                                                 "capt (runs/laptop/capt_motion1_seed3/best.pt)": 3.0})
+    rules = [cv.parse_rename("capt (*capt_motion1_*)=capt_motion1"), cv.parse_rename("capt (*)=capt")]
+    result = cv.compare([seed2, seed3], draws=100, seed=0, reference="capt_motion1", rename=rules)
+    assert result["runs"] == {"laptop": {"capt": 2, "capt_motion1": 2}}
+    assert result["paired"]["capt"]["mean"]["dir_med"]["difference"] == pytest.approx(1.0)
+    assert result["rename"] == [["capt (*capt_motion1_*)", "capt_motion1"], ["capt (*)", "capt"]]
+    clash = r"seed2.json: --rename gives two of its methods the name\(s\) \['capt'\]"
+    with pytest.raises(ValueError, match=clash):
+        cv.compare([seed2], draws=0, rename=[("capt (*)", "capt")])
+    assert cv.parse_rename("a=b=c") == ("a=b", "c")
+    with pytest.raises(ValueError, match="PATTERN=NAME"):
+        cv.parse_rename("capt")
+
+
 def test_main_writes_markdown_and_json_with_its_command(tmp_path, monkeypatch, load_script):
     cv = load_script("compare_variants")
     a = _write(tmp_path / "a.json", "oven", {
