@@ -7,6 +7,7 @@ import json
 import math
 import os
 import platform
+import shlex
 import sys
 import tempfile
 from pathlib import Path
@@ -48,7 +49,7 @@ def write_json(path: str | os.PathLike | None, payload: dict[str, Any], command:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     if command is None:
-        command = " ".join(["capt", *sys.argv[1:]])
+        command = shlex.join(["capt", *sys.argv[1:]])
     data = {"command": command, "machine": machine_info(), **payload}
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
     with os.fdopen(fd, "w") as fh:
@@ -59,8 +60,9 @@ def write_json(path: str | os.PathLike | None, payload: dict[str, Any], command:
 
 
 def script_command() -> str:
-    """The running repository script's command line, as ``.venv/bin/python scripts/<name>.py ARGS``."""
-    return " ".join([".venv/bin/python", f"scripts/{Path(sys.argv[0]).name}", *sys.argv[1:]])
+    """The running repository script's command line, as ``.venv/bin/python scripts/<name>.py ARGS``,
+    shell-quoted (an argument with spaces, like a ``--rename`` rule, pastes back as one)."""
+    return shlex.join([".venv/bin/python", f"scripts/{Path(sys.argv[0]).name}", *sys.argv[1:]])
 
 
 def write_markdown(path: str | os.PathLike | None, text: str, command: str) -> None:

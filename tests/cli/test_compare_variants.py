@@ -260,3 +260,8 @@ def test_main_writes_markdown_and_json_with_its_command(tmp_path, monkeypatch, l
     written = json.loads(js.read_text())
     assert written["command"] == command and "cpu_count" in written["machine"]
     assert written["categories"]["oven"]["capt_plain"]["dir_med"] == pytest.approx(2.0)
+    # an argument with spaces is quoted, so the recorded command pastes back into a shell
+    monkeypatch.setattr("sys.argv", ["compare_variants.py", str(a), "--draws", "0", "--rename",
+                                     "capt (*)=capt", "--json", str(js)])
+    cv.main()
+    assert json.loads(js.read_text())["command"].endswith(f"--rename 'capt (*)=capt' --json {js}")
