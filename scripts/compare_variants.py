@@ -136,7 +136,7 @@ def compare(paths: list[Path], reference: str = "capt", draws: int = 2000, seed:
         if clash:
             raise ValueError(f"{path}: --rename gives two of its methods the name(s) {clash}: "
                              f"{sorted(run['summary'])}")
-        run["summary"] = {name(m): v for m, v in run["summary"].items()}
+        run["summary"] = dict(zip(names, run["summary"].values(), strict=True))
         poses.setdefault(run.get("test_pose", "world"), []).append(str(path))
         corruption = json.dumps({"test_corruption": run.get("test_corruption", CLEAN),
                                  "outlier_filter": run.get("outlier_filter")}, sort_keys=True)
