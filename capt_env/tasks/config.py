@@ -8,6 +8,12 @@ from typing import Literal
 from perception.yaml_config import ConfigError, require
 
 Split = Literal["train", "val", "test", "all"]
+ClosedLimit = Literal["auto", "lower", "upper"]
+MjcfAngle = Literal["auto", "radian", "degree"]
+NAMED_FRONTS: dict[str, float] = {"+x": 0.0, "x": 0.0, "+y": 1.5707963267948966, "y": 1.5707963267948966,
+                                  "-x": 3.141592653589793, "-y": -1.5707963267948966}
+"""Named front directions of a user file: the azimuth (radians, file frame) of its front's outward
+normal."""
 
 DEFAULT_OBJECT_XY: tuple[float, float] = (0.3, 0.0)
 """World (x, y) metres of an object's bounding-box centre when neither the task nor its category
@@ -76,6 +82,23 @@ class TaskConfig:
     Both default to nearly closed (as in ManiSkill's OpenCabinet tasks): an open drawer above the
     target one reaches into the Panda's wrist at reset. Data generation opens everything at random.
 
+    User files (all lengths after ``scale``, frames are the file's root frame):
+
+    - ``front_yaw``: azimuth (radians, counter-clockwise about +z from the file's +x) of the
+      object's front normal, or one of ``"+x"``, ``"-x"``, ``"+y"``, ``"-y"``; None guesses it from
+      the moving part (see ``docs/user_objects.md``). The task turns this direction to the robot.
+    - ``closed``: which limit of each joint is closed (``lower``/``upper``); ``auto`` takes, per
+      joint, the limit at which the whole object's bounding box is smaller (a part swung or pulled
+      out takes room), the lower one on a tie. Joint states are then 0 closed and grow while opening.
+    - ``joint_damping`` (N m s/rad or N s/m) and ``joint_friction`` (Coulomb, N m or N) replace the
+      file's values on every movable joint; ``part_mass`` (kg) sets the moving link's mass (inertia
+      scaled with it); ``density`` (kg/m^3) is used for links whose file gives no mass.
+    - ``grasp_point`` (metres, file frame at the closed state) or ``handle`` (the name of a link or
+      geom on the moving part) sets the grasp target; default: a handle found by name, else by
+      geometry (the part of the moving link standing off its outer face).
+    - ``visual_groups``: MJCF geom groups drawn by the cameras; ``mjcf_angle``: the unit of an MJCF
+      file's angles (``auto``: its compiler, or radians for an included fragment with radian ranges).
+
     Success: the target joint is opened past ``success_fraction`` of its range and at rest
     (child link speed below ``rest_linear_speed`` m/s and ``rest_angular_speed`` rad/s).
     """
@@ -84,6 +107,16 @@ class TaskConfig:
     object: str | None = None
     joint: str | None = None
     scale: float = 1.0
+    front_yaw: float | str | None = None
+    closed: ClosedLimit = "auto"
+    joint_damping: float | None = None
+    joint_friction: float | None = None
+    part_mass: float | None = None
+    density: float | None = None
+    grasp_point: tuple[float, float, float] | None = None
+    handle: str | None = None
+    visual_groups: tuple[int, ...] = (0, 1, 2)
+    mjcf_angle: MjcfAngle = "auto"
     split: Split = "train"
     instance_ids: tuple[int, ...] | None = None
     object_xy: tuple[float, float] | None = None
@@ -108,8 +141,21 @@ class TaskConfig:
                 self.category in CATEGORIES,
                 f"unknown category {self.category!r}; known: {list(CATEGORIES)}",
             )
-        if self.joint is not None and self.object is None:
-            raise ConfigError("'joint' selects a joint of a user 'object' file; it needs 'object'")
+        if self.object is None:
+            for key in USER_FILE_KEYS:
+                if getattr(self, key) != getattr(_DEFAULTS, key):
+                    raise ConfigError(f"{key!r} applies to a user 'object' file; it needs 'object'")
+        if isinstance(self.front_yaw, str):
+            require(self.front_yaw in NAMED_FRONTS,
+                    f"front_yaw must be radians or one of {list(NAMED_FRONTS)}, got {self.front_yaw!r}")
+        for key in ("joint_damping", "joint_friction"):
+            value = getattr(self, key)
+            require(value is None or value >= 0, f"{key} must be >= 0, got {value}")
+        for key in ("part_mass", "density"):
+            value = getattr(self, key)
+            require(value is None or value > 0, f"{key} must be > 0, got {value}")
+        require(self.grasp_point is None or self.handle is None,
+                "set at most one of 'grasp_point' and 'handle'")
         require(self.scale > 0, f"scale must be > 0, got {self.scale}")
         for name in ("target_init_fraction", "other_init_fraction"):
             lo, hi = getattr(self, name)
@@ -128,9 +174,21 @@ class TaskConfig:
             require(len(self.instance_ids) > 0, "instance_ids must not be empty")
             require(all(i >= 0 for i in self.instance_ids), "instance_ids must be >= 0")
 
+    def front_yaw_radians(self) -> float | None:
+        """``front_yaw`` as radians (named axes converted), or None when it is to be guessed."""
+        if isinstance(self.front_yaw, str):
+            return NAMED_FRONTS[self.front_yaw]
+        return None if self.front_yaw is None else float(self.front_yaw)
+
     def placement_xy(self) -> tuple[float, float]:
         """World (x, y) metres of the object's bounding-box centre before noise: ``object_xy``, or
         the category's default placement when it is None."""
         if self.object_xy is not None:
             return (float(self.object_xy[0]), float(self.object_xy[1]))
         return CATEGORY_OBJECT_XY.get(self.category or "", DEFAULT_OBJECT_XY)
+
+
+USER_FILE_KEYS = ("joint", "front_yaw", "closed", "joint_damping", "joint_friction", "part_mass", "density",
+                  "grasp_point", "handle", "visual_groups", "mjcf_angle")
+"""Task keys that describe a user object file and need ``object``."""
+_DEFAULTS = TaskConfig(category="laptop")

@@ -14,8 +14,12 @@ the door/lid about its hinge, or pull the drawer.
 - each camera's eye position (+-``jitter`` metres per axis), always looking at the object;
 - the robot's initial joint positions (Gaussian noise ``robot_init_qpos_noise`` rad).
 
+**Joint states.** Every joint's state is 0 closed and grows while opening, in radians or metres:
+for a file whose part is closed at its upper limit the simulator position is turned around
+(``LoadedObject.sim_qpos`` / ``task_state``), and so is the reported axis.
+
 **Success.** The target joint is past ``success_fraction`` (default 0.75) of its range, measured from
-the lower limit, and its child link is at rest.
+the closed state, and its child link is at rest.
 
 **Reward.** Dense: ``reach + 2 * progress + 2 * success`` where ``reach = 1 - tanh(5 d)`` with
 ``d`` the gripper-to-grasp-point distance in metres (held at 1 once the part has moved),
@@ -172,10 +176,10 @@ class OpenArticulatedEnv(BaseEnv):
                                         torch.as_tensor(yaw, dtype=torch.float32))
             self.articulation.set_pose(Pose.create_from_pq(p=placement.root_p, q=placement.root_q))
 
-            lo, hi = obj.limits[:, 0], obj.limits[:, 1]
+            span = obj.limits[:, 1] - obj.limits[:, 0]
             frac = np.stack([rng.uniform(*cfg.other_init_fraction) for _ in range(obj.dof)], axis=-1)
             frac[:, obj.target_joint] = rng.uniform(*cfg.target_init_fraction)
-            qpos = lo + frac.reshape(b, obj.dof) * (hi - lo)
+            qpos = obj.sim_qpos(frac.reshape(b, obj.dof) * span)
             self.articulation.set_qpos(torch.as_tensor(qpos, dtype=torch.float32))
             self.articulation.set_qvel(torch.zeros((b, obj.dof)))
             self._aim_cameras(placement, float(np.asarray(yaw).reshape(-1)[0]), self._episode_rng)
@@ -221,16 +225,16 @@ class OpenArticulatedEnv(BaseEnv):
         """World-frame ground truth of every movable joint, batched: see the module docstring."""
         obj = self.object
         axes, pivots = [], []
-        for joint in obj.joints:
+        for joint, sign in zip(obj.joints, obj.open_sign, strict=True):
             mat = joint.get_global_pose().to_transformation_matrix()  # (b, 4, 4)
-            axes.append(mat[..., :3, 0])
+            axes.append(float(sign) * mat[..., :3, 0])  # turned so that a growing state opens
             pivots.append(mat[..., :3, 3])
         b = self.num_envs
         return {
             "joint_type": torch.as_tensor(obj.joint_type_ids, device=self.device).expand(b, -1),
             "joint_axis": torch.stack(axes, dim=1),
             "joint_pivot": torch.stack(pivots, dim=1),
-            "joint_state": self.articulation.qpos,
+            "joint_state": obj.task_state(self.articulation.qpos),
             "joint_limits": torch.as_tensor(obj.limits, dtype=torch.float32, device=self.device)
             .expand(b, -1, -1),
             "joint_child_part": torch.as_tensor(obj.child_parts, device=self.device).expand(b, -1),
@@ -249,8 +253,7 @@ class OpenArticulatedEnv(BaseEnv):
         gt = self.joint_ground_truth()
         k = obj.target_joint
         lo, hi = float(obj.limits[k, 0]), float(obj.limits[k, 1])
-        q = self.articulation.qpos[:, k]
-        open_fraction = (q - lo) / (hi - lo)
+        open_fraction = (gt["joint_state"][:, k] - lo) / (hi - lo)
         child = obj.target_child_link
         at_rest = (torch.linalg.norm(child.linear_velocity, dim=-1) <= cfg.rest_linear_speed) & (
             torch.linalg.norm(child.angular_velocity, dim=-1) <= cfg.rest_angular_speed
@@ -271,7 +274,7 @@ class OpenArticulatedEnv(BaseEnv):
             obs.update(
                 grasp_point=info["grasp_point"],
                 tcp_to_grasp=info["grasp_point"] - self.agent.tcp.pose.p,
-                target_qpos=self.articulation.qpos[:, [self.object.target_joint]],
+                target_qpos=self.object.task_state(self.articulation.qpos)[:, [self.object.target_joint]],
                 open_fraction=info["open_fraction"].unsqueeze(-1),
             )
         return obs

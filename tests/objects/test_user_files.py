@@ -10,7 +10,12 @@ import pytest
 from capt_env.objects.builder import joint_world_axis
 from capt_env.objects.registry import CATEGORIES, make_object
 from capt_env.objects.scene import create_scene
-from capt_env.objects.user_files import load_user_object, spec_to_urdf
+from capt_env.objects.user_files import (
+    FRICTION_MAX_SPEED,
+    FRICTION_SATURATION_SPEED,
+    load_user_object,
+    spec_to_urdf,
+)
 
 MJCF = """<mujoco model="box_door">
   <worldbody>
@@ -53,7 +58,11 @@ def test_urdf_round_trip(scene, tmp_path: Path, category: str) -> None:
         assert np.linalg.norm(off - (off @ direction) * direction) < 1e-4
         sim_joint = art.joints_map[joint.name]
         assert sim_joint.limits.reshape(-1).tolist() == pytest.approx(joint.limits, abs=1e-5)
-        assert float(sim_joint.friction[0]) == pytest.approx(joint.friction, rel=1e-5)
+        # URDF friction is a Coulomb force/torque: a velocity drive capped at friction + damping * 1
+        assert float(sim_joint.force_limit[0]) == pytest.approx(
+            joint.friction + joint.damping * FRICTION_MAX_SPEED, rel=1e-5)
+        assert float(sim_joint.damping[0]) == pytest.approx(
+            max(joint.damping, joint.friction / FRICTION_SATURATION_SPEED), rel=1e-5)
     # masses from the URDF inertials match the spec's box volumes x density
     link = spec.links[-1]
     volume = sum(float(np.prod(2 * np.asarray(b.half_size))) for b in link.boxes)
