@@ -16,7 +16,7 @@ import numpy as np
 
 from agents.scripted.config import ScriptedOpenerConfig
 from agents.scripted.opener import Phase, ScriptedOpener
-from capt_env.registration import env_id
+from capt_env.registration import GENERIC_ID, env_id
 from capt_env.wrappers.config import PerceptionWrapperConfig
 from capt_env.wrappers.perception_wrapper import CaptObservationWrapper
 
@@ -34,11 +34,17 @@ class EpisodeResult:
     phase: str
 
 
-def make_env(category: str, wrapper: PerceptionWrapperConfig | dict | None = None,
+def make_env(category: str | None, wrapper: PerceptionWrapperConfig | dict | None = None,
              task: dict | None = None, obs_mode: str = "state", **kwargs: Any) -> CaptObservationWrapper:
-    """A ``pd_ee_delta_pose`` env of ``category`` (test split by default) wrapped for the opener."""
-    task_cfg = {"split": "test", **(task or {})}
+    """A ``pd_ee_delta_pose`` env wrapped for the opener: of ``category`` (test split by default),
+    or, with ``category`` None, of the user file ``task["object"]``."""
     kwargs.setdefault("control_mode", "pd_ee_delta_pose")
+    if category is None:
+        if not (task or {}).get("object"):
+            raise ValueError("make_env needs a category or a task with an 'object' file")
+        env = gym.make(GENERIC_ID, obs_mode=obs_mode, task=dict(task), **kwargs)
+        return CaptObservationWrapper(env, wrapper)
+    task_cfg = {"split": "test", **(task or {})}
     env = gym.make(env_id(category), obs_mode=obs_mode, task=task_cfg, **kwargs)
     return CaptObservationWrapper(env, wrapper)
 

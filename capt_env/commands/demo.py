@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from capt_env.commands.json_output import write_json
+from capt_env.commands.object_targets import add_object_arguments, object_targets, target_task
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 
 OPENED_CATEGORIES = ("laptop", "oven", "washing_machine", "drawer_cabinet", "cabinet_door")
@@ -33,6 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-policy", action="store_true", help="only estimate; do not open the object")
     parser.add_argument("--no-video", action="store_true", help="run the policy without recording MP4s")
     add_task_argument(parser)
+    add_object_arguments(parser, None, with_categories=False)
 
 
 def axis_errors(est_joint, info: dict) -> dict[str, float | None]:
@@ -79,26 +81,32 @@ def run(args: argparse.Namespace) -> int:
     from perception.checkpoints import default_checkpoint, shipped_categories
     from perception.inference import ArticulationEstimator
 
-    categories = [args.category] if args.category else shipped_categories()
-    if not categories:
+    files = bool(args.object or args.objects)
+    args.categories = [args.category] if args.category else ([] if files else shipped_categories())
+    if not args.categories and not files:
         raise SystemExit("no shipped checkpoint found; pass --category and --checkpoint")
     out_dir = Path(args.out)
-    overrides = task_overrides(args.task)
+    overrides = {"cameras": [{"width": 160, "height": 160}], **task_overrides(args.task)}
     report = []
-    for category in categories:
-        ckpt = args.checkpoint or default_checkpoint(category)
+    for target in object_targets(args):
+        category = target.category
+        ckpt = args.checkpoint or default_checkpoint(target.model_category())
         estimator = ArticulationEstimator.from_checkpoint(ckpt)
-        env = gym.make(capt_env.env_id(category), obs_mode="pointcloud",
-                       task={"split": "test", "cameras": [{"width": 160, "height": 160}], **overrides})
+        task = target_task(target, overrides)
+        if category is None:
+            env = gym.make(capt_env.registration.GENERIC_ID, obs_mode="pointcloud", task=task)
+        else:
+            env = gym.make(capt_env.env_id(category), obs_mode="pointcloud", task={"split": "test", **task})
         try:
             for ep in range(args.episodes):
-                tag = f"{category}_episode{ep}"
-                row = {"category": category, **estimate_episode(env, estimator, args.seed + ep, out_dir, tag)}
-                if not args.no_policy and category in OPENED_CATEGORIES:
+                tag = f"{target.label}_episode{ep}"
+                row = {"object": target.label, "category": category,
+                       **estimate_episode(env, estimator, args.seed + ep, out_dir, tag)}
+                if not args.no_policy and (category is None or category in OPENED_CATEGORIES):
                     from capt_env.commands.demo_policy import open_with_capt
 
                     row.update(open_with_capt(category, ckpt, args.seed + ep, out_dir, tag,
-                                              video=not args.no_video, task=overrides))
+                                              video=not args.no_video, task=task))
                 elif not args.no_policy:
                     row["not_opened"] = "estimate only: the scripted opener is not built for this category"
                 report.append(row)
@@ -109,7 +117,8 @@ def run(args: argparse.Namespace) -> int:
                 elif "success" in row:
                     outcome = "SUCCESS" if row["success"] else "failed"
                     opened = f"  opened {row['open_fraction']:.0%} -> {outcome}"
-                print(f"{tag} (instance {row['instance_id']}, unseen): axis direction error "
+                what = "user file" if category is None else f"instance {row['instance_id']}, unseen"
+                print(f"{tag} ({what}): axis direction error "
                       f"{row['direction_deg']:.1f} deg, position {pos}, state {row['state']:.2f} "
                       f"{row['state_unit']}, {row['latency_ms']:.0f} ms{opened}")
         finally:

@@ -5,12 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 
 
-def open_with_capt(category: str, checkpoint: str | Path, seed: int, out_dir: Path, tag: str,
+def open_with_capt(category: str | None, checkpoint: str | Path, seed: int, out_dir: Path, tag: str,
                    video: bool = True, every_k_steps: int = 5, max_steps: int = 200,
                    task: dict | None = None) -> dict:
     """Run one episode (same seed, so the same unseen instance as the estimate) and return the outcome:
     success, final open fraction, steps, and the MP4 path when ``video``. ``task`` holds TaskConfig
-    overrides (e.g. the cameras)."""
+    overrides (e.g. the cameras); with ``category`` None, ``task["object"]`` is the user file."""
     import imageio.v2 as imageio
     import numpy as np
 

@@ -27,7 +27,7 @@ class EpisodeJob:
     mode, the policy (``scripted`` with ``opener``, or ``ppo`` with the ``model`` file) and the step
     limit."""
 
-    category: str
+    category: str | None  # None: the user file in task["object"]
     wrapper: dict[str, Any]
     task: dict[str, Any]
     obs_mode: str

@@ -3,7 +3,7 @@
 ``capt evaluate`` scores the network on dataset clouds; this scores what a policy is given: the
 observation wrapper's estimate (object isolation, CAPT, the handle and axis-sign geometry and, when
 on, the hinge put on the moving part's edge, found on the part's coplanar panel) on freshly reset
-test-split scenes, world frame.
+test-split scenes or user files (``--object``), world frame.
 Errors per reset: the signed direction error (degrees; a flipped axis counts as ~180), the
 distance between the estimated and true axis lines (revolute joints only, metres) and the grasp
 point's distance to the true one (metres).
@@ -18,13 +18,14 @@ from typing import Any
 import numpy as np
 
 from capt_env.commands.json_output import write_json
+from capt_env.commands.object_targets import add_object_arguments, object_targets, target_task
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 from capt_env.wrappers.config import PerceptionWrapperConfig
 from capt_env.wrappers.estimate import JointAxisEstimate
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--categories", nargs="+", default=["cabinet_door"], help="object categories")
+    add_object_arguments(parser, ["cabinet_door"])
     parser.add_argument("--resets", type=int, default=8, help="resets (unseen instances) per category")
     parser.add_argument("--first-seed", type=int, default=0, help="resets use seeds first..first+n-1")
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
@@ -95,31 +96,34 @@ def run(args: argparse.Namespace) -> int:
     panel_on = PerceptionWrapperConfig().panel_max_state
     seeds = list(range(args.first_seed, args.first_seed + args.resets))
     task = task_overrides(args.task)
-    header = ("| category | hinge on part edge | dense geometry | slide along front | coplanar panel | "
+    targets = object_targets(args)
+    header = ("| object | hinge on part edge | dense geometry | slide along front | coplanar panel | "
               "direction (deg) | sign right | line (cm, mean) | line (cm, median) | grasp point (cm) | "
               "grasp > 10 cm | resets |")
     table, results = [header, "|" + " --- |" * 12], []
-    for category in args.categories:
+    for target in targets:
+        like = target.model_category()
         for combo in combos:
             wrapper = {"source": "capt", "every_k_steps": 1,
                        "hinge_on_part_edge": combo["hinge_on_part_edge"],
                        "dense_geometry": combo["dense_geometry"],
                        "slide_along_front": combo["slide_along_front"],
                        "panel_max_state": panel_on if combo["coplanar_panel"] else 0.0,
-                       "checkpoint": str(args.checkpoint or default_checkpoint(category))}
-            env = make_env(category, wrapper, task=task, obs_mode="pointcloud")
+                       "checkpoint": str(args.checkpoint or default_checkpoint(like))}
+            env = make_env(target.category, wrapper, task=target_task(target, task), obs_mode="pointcloud")
             rows = []
             try:
-                desc = category + "".join(f" {k.split('_')[0]} {_on(v)}" for k, v in combo.items())
+                desc = target.label + "".join(f" {k.split('_')[0]} {_on(v)}" for k, v in combo.items())
                 for seed in tqdm(seeds, desc=desc, leave=False):
                     _, info = env.reset(seed=seed)
                     rows.append({"seed": seed, **estimate_errors(env.estimate, ground_truth_estimate(info))})
             finally:
                 env.close()
             s = _summary(rows)
-            results.append({"category": category, **combo, **s, "per_reset": rows})
+            results.append({"object": target.label, "category": target.category,
+                            "checkpoint": wrapper["checkpoint"], **combo, **s, "per_reset": rows})
             on_off = "".join(f"{_on(v)} | " for v in combo.values())
-            table.append(f"| {category.replace('_', ' ')} | {on_off}"
+            table.append(f"| {target.label.replace('_', ' ')} | {on_off}"
                          f"{s['direction_deg_mean']:.1f} | {s['sign_right']:.2f} | {_cm(s['line_m_mean'])} | "
                          f"{_cm(s['line_m_median'])} | {100 * s['grasp_m_mean']:.1f} | "
                          f"{s['grasp_far']:.2f} | {s['resets']} |")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from capt_env.commands.json_output import write_json
+from capt_env.commands.object_targets import add_object_arguments, object_targets
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -16,6 +17,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--test", type=int, default=None, help="override the number of test samples")
     parser.add_argument("--seed", type=int, default=None)
     parser.add_argument("--workers", type=int, default=None, help="processes (default: every core)")
+    add_object_arguments(parser, None, with_categories=False)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -35,6 +37,15 @@ def run(args: argparse.Namespace) -> int:
         changes["category"] = args.category
     if args.seed is not None:
         changes["seed"] = args.seed
+    if args.object or args.objects:
+        if args.category:
+            raise SystemExit("give either --category or one user file (--object / --objects)")
+        args.categories = []
+        files = object_targets(args)
+        if len(files) != 1:
+            raise SystemExit(f"capt generate renders one object per dataset; got {[t.label for t in files]}")
+        changes["object"] = dict(files[0].task)
+        changes["category"] = files[0].label
     cfg = dataclasses.replace(cfg, **changes)
     cfg.validate()
     result = generate(cfg, args.out, workers=args.workers)

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import asdict
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from capt_env.commands.episode_log import EpisodeLog
 from capt_env.commands.json_output import write_json
 from capt_env.commands.noise_overrides import add_noise_argument, noise_overrides, resolved_noise
+from capt_env.commands.object_targets import add_object_arguments, object_targets, target_task
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 from perception.yaml_config import to_dict
 
@@ -18,7 +20,7 @@ if TYPE_CHECKING:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--categories", nargs="+", default=["cabinet_door"], help="object categories")
+    add_object_arguments(parser, ["cabinet_door"])
     parser.add_argument("--policy", default="scripted", choices=["scripted", "ppo"])
     parser.add_argument("--model", default=None,
                         help="PPO model .zip (with --policy ppo; default: the category's shipped policy)")
@@ -97,8 +99,10 @@ def success_cells(row: dict[str, Any]) -> str:
 def run(args: argparse.Namespace) -> int:
     from capt_env.commands.episode_runner import EpisodeJob, play_episodes
 
-    header = "| category | perception | success | 95% interval | mean opened | mean steps | episodes |"
-    rows, lines = [], [header, "| --- | --- | --- | --- | --- | --- | --- |"]
+    header = ("| object | perception | model | success | 95% interval | mean opened | mean steps | "
+              "episodes |")
+    rows, lines = [], [header, "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    targets = object_targets(args)
     seeds = list(range(args.first_seed, args.first_seed + args.episodes))
     task = task_overrides(args.task)
     if args.opener is not None and args.policy != "scripted":
@@ -112,7 +116,8 @@ def run(args: argparse.Namespace) -> int:
     noise = noise_overrides(args.noise)
     if args.noise and "noisy_oracle" not in args.perception:
         raise SystemExit("--noise sets the noisy_oracle source's noise; add noisy_oracle to --perception")
-    for category in args.categories:
+    for target in targets:
+        like = target.model_category()
         for source in args.perception:
             wrapper: dict[str, Any] = {"source": source, "every_k_steps": args.every_k_steps}
             if source == "noisy_oracle":
@@ -121,21 +126,22 @@ def run(args: argparse.Namespace) -> int:
             if source == "capt":
                 from perception.checkpoints import default_checkpoint
 
-                wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(category))
+                wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(like))
                 obs_mode = "pointcloud"
-            model = ppo_model(args, category)
-            job = EpisodeJob(category, wrapper, task, obs_mode, args.policy, model, opener, args.max_steps)
+            model = ppo_model(args, like)
+            job = EpisodeJob(target.category, wrapper, target_task(target, task), obs_mode, args.policy,
+                             model, opener, args.max_steps)
             log = None if args.episode_log is None else EpisodeLog(args.episode_log, job.identity())
-            episodes = play_episodes(job, seeds, args.workers, log, desc=f"{category} {source}")
-            row = {"category": category, "policy": args.policy, "model": model, "perception": source,
-                   **success_row(episodes)}
+            episodes = play_episodes(job, seeds, args.workers, log, desc=f"{target.label} {source}")
+            used = Path(wrapper["checkpoint"]).stem if source == "capt" else (model and Path(model).stem)
+            row = {"object": target.label, "category": target.category, "task": job.task,
+                   "policy": args.policy, "model": model, "perception": source,
+                   "checkpoint": wrapper.get("checkpoint"), "like": like, **success_row(episodes)}
             rows.append(row)
-            lines.append(f"| {category} | {source} | {success_cells(row)} |")
+            lines.append(f"| {target.label} | {source} | {used or '-'} | {success_cells(row)} |")
     table = "\n".join(lines)
     print(table)
     if args.markdown:
-        from pathlib import Path
-
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
         Path(args.markdown).write_text(table + "\n")
     write_json(args.json, {"seeds": seeds, "policy": args.policy, "max_steps": args.max_steps,

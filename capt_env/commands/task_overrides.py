@@ -10,7 +10,8 @@ def add_task_argument(parser: argparse.ArgumentParser) -> None:
     """Add ``--task PATH`` to a command's parser."""
     parser.add_argument("--task", default=None,
                         help="YAML of TaskConfig overrides for every category (cameras, placement, ...), "
-                             "e.g. configs/tasks/two_cameras.yaml; no category/object key")
+                             "e.g. configs/tasks/two_cameras.yaml; no category/object key (use "
+                             "--categories / --object)")
 
 
 def task_overrides(path: str | None) -> dict:
@@ -25,5 +26,5 @@ def task_overrides(path: str | None) -> dict:
         raise SystemExit(f"--task {path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
     clash = sorted({"category", "object"} & set(raw))
     if clash:
-        raise SystemExit(f"--task {path}: {clash} would override --categories; remove them")
+        raise SystemExit(f"--task {path}: {clash} would override --categories/--object; remove them")
     return raw

@@ -76,7 +76,7 @@ _ENV_KEY: tuple | None = None
 
 def _env_for(cfg: GenerateConfig) -> Any:
     global _ENV, _ENV_KEY
-    key = (cfg.category, to_json(cfg.camera))
+    key = (cfg.category, json.dumps(cfg.object, sort_keys=True), to_json(cfg.camera))
     if _ENV is None or _ENV_KEY != key:
         import gymnasium as gym
 
@@ -84,10 +84,11 @@ def _env_for(cfg: GenerateConfig) -> Any:
 
         if _ENV is not None:
             _ENV.close()
+        what = {"category": cfg.category, "split": "all"} if cfg.object is None else dict(cfg.object)
         task = {
             # the placement the shipped datasets were rendered at (cameras aim at the object, so
             # only what the robot hides depends on it), whatever the category's task default
-            "category": cfg.category, "split": "all", "cameras": [to_dict(cfg.camera)],
+            **what, "cameras": [to_dict(cfg.camera)],
             "object_xy": [0.3, 0.0],
             "target_init_fraction": [0.0, 1.0], "other_init_fraction": [0.0, 1.0],
         }
@@ -148,12 +149,12 @@ def render_shard(cfg: GenerateConfig, job: ShardJob) -> dict[str, np.ndarray]:
 
     env = _env_for(cfg)
     rng = np.random.default_rng([cfg.seed, SPLITS.index(job.split), job.index])
-    allowed = instance_ids(cfg.category, job.split)
+    allowed = instance_ids(cfg.category, job.split) if cfg.object is None else [-1]
     samples: list[dict] = []
     while len(samples) < job.num_samples:
         iid = int(rng.choice(allowed))
-        obs, info = env.reset(seed=int(rng.integers(2**31)),
-                              options={"reconfigure": True, "instance_id": iid})
+        options = {"reconfigure": True, "instance_id": iid} if iid >= 0 else {}
+        obs, info = env.reset(seed=int(rng.integers(2**31)), options=options)
         for view in range(cfg.views_per_instance):
             if len(samples) >= job.num_samples:
                 break

@@ -323,14 +323,21 @@ def _rpy_from_quat(quat: Any) -> np.ndarray:
 def spec_to_urdf(spec: ObjectSpec, robot_name: str | None = None) -> str:
     """URDF text of ``spec``: one ``<link>`` per link (box visuals and collisions, inertia from the
     boxes at the link's density) and one ``<joint>`` per joint (origin at the pivot, ``<axis>`` as
-    in the spec, limits, damping and friction). Link and joint names are the spec's."""
+    in the spec, limits, damping and friction). Link and joint names are the spec's.
+
+    A spec's link frames all coincide at state 0, while a URDF child frame sits at its joint's
+    origin, so each link's geometry is written relative to its own joint's pivot (object frame
+    offsets; every frame keeps the object frame's orientation)."""
     name = robot_name or f"{spec.category}_{spec.instance_id}"
+    offset = {spec.links[0].name: np.zeros(3)}
+    offset.update({j.child: np.asarray(j.origin, dtype=np.float64) for j in spec.joints})
     lines = ['<?xml version="1.0"?>', f"<robot name={quoteattr(name)}>"]
     for k, link in enumerate(spec.links):
+        shift = offset.get(link.name, np.zeros(3))
         lines.append(f"  <link name={quoteattr(link.name)}>")
         mass, com, inertia = _link_inertial(link)
         lines.append("    <inertial>")
-        lines.append(f'      <origin xyz="{_fmt(com)}" rpy="0 0 0"/>')
+        lines.append(f'      <origin xyz="{_fmt(com - shift)}" rpy="0 0 0"/>')
         lines.append(f'      <mass value="{mass:.9g}"/>')
         lines.append(
             f'      <inertia ixx="{inertia[0, 0]:.9g}" ixy="{inertia[0, 1]:.9g}" ixz="{inertia[0, 2]:.9g}" '
@@ -338,7 +345,8 @@ def spec_to_urdf(spec: ObjectSpec, robot_name: str | None = None) -> str:
         )
         lines.append("    </inertial>")
         for b_idx, box in enumerate(link.boxes):
-            origin = f'<origin xyz="{_fmt(box.pos)}" rpy="{_fmt(_rpy_from_quat(box.quat))}"/>'
+            rpy = _fmt(_rpy_from_quat(box.quat))
+            origin = f'<origin xyz="{_fmt(np.asarray(box.pos) - shift)}" rpy="{rpy}"/>'
             size = f'<geometry><box size="{_fmt(np.asarray(box.half_size) * 2)}"/></geometry>'
             lines.append(
                 f'    <visual name="{link.name}_box{b_idx}">{origin}{size}'
@@ -351,7 +359,8 @@ def spec_to_urdf(spec: ObjectSpec, robot_name: str | None = None) -> str:
         lines.append(f"  <joint name={quoteattr(joint.name)} type={quoteattr(joint.type)}>")
         lines.append(f"    <parent link={quoteattr(joint.parent)}/>")
         lines.append(f"    <child link={quoteattr(joint.child)}/>")
-        lines.append(f'    <origin xyz="{_fmt(joint.origin)}" rpy="0 0 0"/>')
+        rel = offset[joint.child] - offset.get(joint.parent, np.zeros(3))
+        lines.append(f'    <origin xyz="{_fmt(rel)}" rpy="0 0 0"/>')
         lines.append(f'    <axis xyz="{_fmt(joint.axis)}"/>')
         lo, hi = joint.limits
         lines.append(f'    <limit lower="{lo:.9g}" upper="{hi:.9g}" effort="1000" velocity="10"/>')

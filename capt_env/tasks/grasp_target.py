@@ -31,11 +31,14 @@ STANDOFF = 0.01
 """m: geometry this far beyond the outer face counts as standing off it (a handle)."""
 GRIP_DEPTH = 0.015
 """m: depth of a handle's outermost layer, about a Panda fingertip's width."""
-CLUSTER_RADIUS = 0.015
+CLUSTER_RADIUS = 0.02
 """m: surface points closer than this belong to the same piece of a handle."""
 FACE_BIN = 0.002
 """m: histogram bin for finding the outer face's level."""
-SAMPLES = 4000
+SAMPLES = 20000
+FACING_SHARE = 0.08
+"""A sliding part with at least this share of its surface in one 4 mm slab across the slide has a
+face across it (a drawer front); below, it is a panel sliding within its plane (a window)."""
 
 
 @dataclass(frozen=True)
@@ -59,7 +62,8 @@ def outward_normal(points: np.ndarray, axis: np.ndarray, pivot: np.ndarray, revo
     side is the one the free edge moves towards while opening (``axis`` is the opening direction),
     since a door or lid swings out towards whoever opens it. Sliding part: a part that slides along
     its own face's normal (a drawer) faces along the opening direction; a thin panel sliding within
-    its plane (a window, a sliding door) faces away from the whole object's centre.
+    its plane (a window, a sliding door) faces away from the whole object's centre along the
+    panel's normal.
     """
     axis = _unit(np.asarray(axis, dtype=np.float64))
     centred = points - points.mean(axis=0)
@@ -72,13 +76,25 @@ def outward_normal(points: np.ndarray, axis: np.ndarray, pivot: np.ndarray, revo
         lever = lever - (lever @ axis) * axis
         motion = np.cross(axis, lever)
         return normal if motion @ normal >= 0 else -normal
-    vals, vecs = np.linalg.eigh(centred.T @ centred)
-    thin = vecs[:, 0]
-    is_panel = np.sqrt(max(vals[0], 0.0)) < 0.35 * np.sqrt(max(vals[1], 1e-12))
-    if is_panel and abs(thin @ axis) < 0.5:  # slides within its own plane
-        offset = (points.mean(axis=0) - object_centre) @ thin
-        return thin if offset >= 0 else -thin
-    return axis
+    along = centred @ axis
+    if _largest_layer_share(along) >= FACING_SHARE:  # a face across the slide: a drawer front
+        return axis
+    flat = centred - np.outer(along, axis)  # a panel sliding within its own plane
+    _, vecs = np.linalg.eigh(flat.T @ flat)
+    thin = vecs[:, 1] if abs(vecs[:, 0] @ axis) > 0.9 else vecs[:, 0]
+    thin = _unit(thin - (thin @ axis) * axis)
+    offset = (points.mean(axis=0) - object_centre) @ thin
+    return thin if offset >= 0 else -thin
+
+
+def _largest_layer_share(heights: np.ndarray, layer: float = 0.004) -> float:
+    """Share of points in the most populated ``layer``-thick slab across a direction: large where a
+    flat face lies across it, about layer / extent where the surface only runs along it."""
+    span = float(heights.max() - heights.min())
+    if span < layer:
+        return 1.0
+    counts, _ = np.histogram(heights, bins=int(np.ceil(span / layer)))
+    return float(counts.max()) / len(heights)
 
 
 def face_level(heights: np.ndarray) -> float:

@@ -20,7 +20,7 @@ from mani_skill.utils.structs import Articulation, ArticulationJoint, Link
 
 from capt_env.objects.builder import build_articulated_object
 from capt_env.objects.errors import ObjectFileError
-from capt_env.objects.link_geometry import ShapeMesh, link_shape_meshes, link_vertices
+from capt_env.objects.link_geometry import ShapeMesh, link_shape_meshes, link_vertices, sample_surface
 from capt_env.objects.registry import make_object
 from capt_env.objects.spec import ObjectSpec
 from capt_env.objects.splits import instance_ids as split_instance_ids
@@ -184,20 +184,72 @@ def _set_qpos(art: Articulation, qpos: np.ndarray) -> None:
 
 
 def _closed_at_upper(art: Articulation, sim_limits: np.ndarray, k: int, closed: str) -> bool:
-    """Whether joint ``k`` is closed at its upper limit. ``auto``: the limit at which the whole
-    object's bounding box is smaller (an opened part takes room: a lid stands up, a door swings out,
-    a drawer slides out), with every other joint at its lower limit; a tie (within 2%) is lower."""
+    """Whether joint ``k`` is closed at its upper limit.
+
+    ``auto``: closed is where the part the joint moves sits with the rest of the object: at each
+    limit (other joints at their lower limits) the mean distance (m) of the part's surface from the
+    rest's bounding box is measured, and the limit where it is smaller (by over 5 mm) is closed; a
+    tie is the lower limit. A closed drawer is inside its cabinet, a closed door or lid lies on its
+    frame, while an opened one stands out; unlike the whole object's size this holds for a door that
+    swings back beside its cabinet.
+    """
     if closed != "auto":
         return closed == "upper"
-    volumes = []
+    moving = _subtree(art, art.active_joints[k].child_link)
+    part = [link for link in art.links if link.name in moving]
+    rest = [link for link in art.links if link.name not in moving]
+    scores = []
     for side in (0, 1):
         q = sim_limits[:, 0].copy()
         q[k] = sim_limits[k, side]
         _set_qpos(art, q)
-        lo, hi = _articulation_aabb(art)
-        volumes.append(float(np.prod(np.maximum(hi - lo, 1e-3))))
+        pts = _world_surface(part)
+        lo, hi = _links_aabb(rest)
+        if len(pts) == 0 or lo is None:
+            _set_qpos(art, sim_limits[:, 0])
+            return False
+        outside = np.maximum(lo - pts, 0) + np.maximum(pts - hi, 0)
+        scores.append(float(np.linalg.norm(outside, axis=1).mean()))
     _set_qpos(art, sim_limits[:, 0])
-    return volumes[1] < 0.98 * volumes[0]
+    return scores[1] < scores[0] - 0.005
+
+
+def _subtree(art: Articulation, root: Link) -> set[str]:
+    """Names of ``root`` and every link below it."""
+    names = {root.name}
+    changed = True
+    while changed:
+        changed = False
+        for link in art.links:
+            parent = link.joint.parent_link
+            if link.name not in names and parent is not None and parent.name in names:
+                names.add(link.name)
+                changed = True
+    return names
+
+
+def _world_surface(links: list[Link], count: int = 800) -> np.ndarray:
+    """Points spread over the links' surfaces, world frame (deterministic)."""
+    meshes = []
+    for link in links:
+        mat = _pose_matrix(link.pose)
+        meshes += [ShapeMesh(m.name, m.vertices @ mat[:3, :3].T + mat[:3, 3], m.faces)
+                   for m in link_shape_meshes(link)]
+    return sample_surface(meshes, count)[0]
+
+
+def _links_aabb(links: list[Link]) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """World-frame bounds (m) of the links' visual geometry; (None, None) if they have none."""
+    pts = []
+    for link in links:
+        verts = link_vertices(link)
+        if len(verts):
+            mat = _pose_matrix(link.pose)
+            pts.append(verts @ mat[:3, :3].T + mat[:3, 3])
+    if not pts:
+        return None, None
+    allp = np.concatenate(pts)
+    return allp.min(axis=0), allp.max(axis=0)
 
 
 def set_link_mass(link: Link, mass: float) -> None:
@@ -317,14 +369,8 @@ def _segmentation_lut(links: list[Link]) -> torch.Tensor:
 
 
 def _articulation_aabb(art: Articulation) -> tuple[np.ndarray, np.ndarray]:
-    pts = []
-    for link in art.links:
-        verts = link_vertices(link)
-        if len(verts) == 0:
-            continue
-        mat = link.pose.to_transformation_matrix()[0].cpu().numpy()
-        pts.append(verts @ mat[:3, :3].T + mat[:3, 3])
-    if not pts:
+    """World-frame bounds (m) of all the object's visual geometry."""
+    lo, hi = _links_aabb(list(art.links))
+    if lo is None:
         raise ObjectFileError("the object has no visual geometry to place it by")
-    allp = np.concatenate(pts)
-    return allp.min(axis=0), allp.max(axis=0)
+    return lo, hi
