@@ -21,6 +21,7 @@ VERBS: dict[str, tuple[str, str]] = {
     "rollout": ("rollout", "success rate of the scripted policy per category and perception source"),
     "noise-sweep": ("noise_sweep", "success rate against the size of one joint-estimate error"),
     "estimate-errors": ("estimate_errors", "errors of the wrapper's CAPT estimate on unseen env resets"),
+    "inspect-object": ("inspect_object", "check a user's URDF/MJCF file: joints, front, reach, a PNG"),
     "bench": ("bench", "environment speed: steps/s in state and pointcloud mode, reset time"),
 }
 
