@@ -147,6 +147,7 @@ def prepare_urdf(path: Path, out_dir: Path) -> PreparedFile:
                 raise ObjectFileError(
                     f"{path}: joint {name!r}: friction {dyn.get('friction')!r} is not a number") from None
             dyn.set("friction", "0")
+    out_dir.mkdir(parents=True, exist_ok=True)
     out = out_dir / f"{path.stem}.urdf"
     tree.write(str(out), xml_declaration=True, encoding="utf-8")
     return PreparedFile(source=path, urdf_path=out, format="urdf", friction=friction,
@@ -154,25 +155,27 @@ def prepare_urdf(path: Path, out_dir: Path) -> PreparedFile:
 
 
 @functools.lru_cache(maxsize=64)
-def _prepare_cached(path: str, mtime_ns: int, visual_groups: tuple[int, ...],
-                    mjcf_angle: str) -> PreparedFile:
+def _prepare_cached(path: str, mtime_ns: int, visual_groups: tuple[int, ...], mjcf_angle: str,
+                    density: float | None) -> PreparedFile:
     src = Path(path)
-    out_dir = _cache_dir(src, (visual_groups, mjcf_angle))
+    out_dir = _cache_dir(src, (visual_groups, mjcf_angle, density))
     suffix = src.suffix.lower()
     if suffix in URDF_SUFFIXES:
         return prepare_urdf(src, out_dir)
     from capt_env.objects.mjcf_to_urdf import convert_mjcf
 
-    conv = convert_mjcf(src, out_dir, visual_groups=visual_groups, angle=mjcf_angle)
+    conv = convert_mjcf(src, out_dir, visual_groups=visual_groups, angle=mjcf_angle,
+                        **({} if density is None else {"density": density}))
     prepared = prepare_urdf(conv.urdf_path, out_dir / "prepared")
     return PreparedFile(source=src, urdf_path=prepared.urdf_path, format="mjcf", friction=prepared.friction,
                         warnings=tuple(conv.warnings) + prepared.warnings)
 
 
 def prepare_object_file(path: str | Path, visual_groups: tuple[int, ...] = (0, 1, 2),
-                        mjcf_angle: str = "auto") -> PreparedFile:
+                        mjcf_angle: str = "auto", density: float | None = None) -> PreparedFile:
     """Check a URDF (``.urdf``) or MJCF (``.xml``/``.mjcf``, full model or included fragment) file
-    and write the URDF the simulator loads (cached per file version and options).
+    and write the URDF the simulator loads (cached per file version and options). ``density``
+    (kg/m^3) is an MJCF file's density for geoms without a mass (a URDF's is set at loading).
 
     :raises FileNotFoundError: if ``path`` does not exist.
     :raises ObjectFileError: for an unsupported suffix or a file that cannot be loaded (the message
@@ -186,7 +189,8 @@ def prepare_object_file(path: str | Path, visual_groups: tuple[int, ...] = (0, 1
             f"unsupported object file {path}: suffix {path.suffix!r}; expected one of "
             f"{list(URDF_SUFFIXES + MJCF_SUFFIXES)}"
         )
-    prepared = _prepare_cached(str(path.resolve()), path.stat().st_mtime_ns, tuple(visual_groups), mjcf_angle)
+    prepared = _prepare_cached(str(path.resolve()), path.stat().st_mtime_ns, tuple(visual_groups), mjcf_angle,
+                               density)
     return dataclasses.replace(prepared, source=path)
 
 
@@ -239,7 +243,7 @@ def load_user_object(
         unknown ``joint`` (the message lists the movable joints).
     """
     path = Path(path)
-    prepared = prepare_object_file(path, visual_groups=visual_groups, mjcf_angle=mjcf_angle)
+    prepared = prepare_object_file(path, visual_groups=visual_groups, mjcf_angle=mjcf_angle, density=density)
     loader = scene.create_urdf_loader()
     loader.name = name
     loader.scale = scale

@@ -62,8 +62,8 @@ def outward_normal(points: np.ndarray, axis: np.ndarray, pivot: np.ndarray, revo
     side is the one the free edge moves towards while opening (``axis`` is the opening direction),
     since a door or lid swings out towards whoever opens it. Sliding part: a part that slides along
     its own face's normal (a drawer) faces along the opening direction; a thin panel sliding within
-    its plane (a window, a sliding door) faces away from the whole object's centre along the
-    panel's normal.
+    its plane (a window, a sliding door) faces the side of its panel that something stands off by
+    over ``STANDOFF`` (its handle), else away from the whole object's centre.
     """
     axis = _unit(np.asarray(axis, dtype=np.float64))
     centred = points - points.mean(axis=0)
@@ -83,6 +83,11 @@ def outward_normal(points: np.ndarray, axis: np.ndarray, pivot: np.ndarray, revo
     _, vecs = np.linalg.eigh(flat.T @ flat)
     thin = vecs[:, 1] if abs(vecs[:, 0] @ axis) > 0.9 else vecs[:, 0]
     thin = _unit(thin - (thin @ axis) * axis)
+    h = centred @ thin
+    mid = float(np.median(h))
+    front, back = float(h.max()) - mid, mid - float(h.min())
+    if abs(front - back) > STANDOFF:  # a handle stands off the outer face only
+        return thin if front > back else -thin
     offset = (points.mean(axis=0) - object_centre) @ thin
     return thin if offset >= 0 else -thin
 
