@@ -7,8 +7,9 @@ installed), unpacks its object files (MJCF fragments with their ``*_dependencies
 meshes) under ``OUT_DIR/metaworld/`` as they are, and writes ``OUT_DIR/corpus.yaml``, the
 ``--objects`` listing that ``capt rollout``, ``capt estimate-errors``, ``capt demo`` and
 ``capt inspect-object`` read. The files are loaded as shipped: the options below only say which
-joint to open and which shipped checkpoint is the closest kind; fronts, closed limits and handles
-are found by the loader. Exit status 3 when the package registry cannot be reached.
+joint to open, which shipped checkpoint is the closest kind and, for the laptop, the placement the
+procedural laptops use; fronts, closed limits and handles are found by the loader. Exit status 3
+when the package registry cannot be reached.
 """
 
 from __future__ import annotations
@@ -25,7 +26,8 @@ ASSETS = "metaworld/assets/"
 CORPUS = [
     # name, file under metaworld/assets, shipped checkpoint of the closest kind, task keys
     ("mw_drawer", "objects/assets/drawer.xml", "drawer_cabinet", {}),
-    ("mw_laptop", "objects/assets/laptop.xml", "laptop", {}),
+    # a lid's lip swings up and back past the Panda's reach from 0.3 m: placed like the laptops
+    ("mw_laptop", "objects/assets/laptop.xml", "laptop", {"object_xy": [-0.08, 0.0]}),
     ("mw_door", "objects/assets/doorlockB.xml", "cabinet_door", {"joint": "doorjoint"}),
     ("mw_window", "objects/assets/window.xml", "drawer_cabinet", {}),
     ("mw_window_horiz", "objects/assets/window_horiz.xml", "drawer_cabinet", {}),

@@ -27,6 +27,7 @@ Every failure is an :class:`ObjectFileError` naming the file and the element.
 from __future__ import annotations
 
 import copy
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -41,6 +42,7 @@ from capt_env.objects.errors import ObjectFileError
 DEFAULT_DENSITY = 1000.0
 MIN_MASS = 1e-3  # kg, for a body without geometry (a frame for a latch or a handle)
 MIN_INERTIA = 1e-6  # kg m^2
+_INERTIA_TERMS = {"xx": (0, 0), "xy": (0, 1), "xz": (0, 2), "yy": (1, 1), "yz": (1, 2), "zz": (2, 2)}
 
 
 @dataclass(frozen=True)
@@ -122,7 +124,8 @@ def dependencies_file(fragment: Path) -> Path | None:
 def _read_defaults(elem: etree._Element, parent: str | None, out: dict) -> None:
     name = elem.get("class") or ("main" if parent is None else None)
     if name is None:
-        raise ObjectFileError(f"{elem.get('_source')}: a nested <default> needs a class (line {elem.sourceline})")
+        raise ObjectFileError(
+            f"{elem.get('_source')}: a nested <default> needs a class (line {elem.sourceline})")
     inherited = copy.deepcopy(out.get(parent, {})) if parent else {}
     for child in elem:
         if not isinstance(child.tag, str):
@@ -162,7 +165,7 @@ def _load_model(path: Path) -> _Model:
     if worldbodies:
         model.roots = [child for wb in worldbodies for child in wb]
     else:
-        model.roots = [child for child in root if isinstance(child.tag, str) and child.tag in ("body", "geom")]
+        model.roots = [c for c in root if isinstance(c.tag, str) and c.tag in ("body", "geom")]
     if not model.roots:
         raise ObjectFileError(f"{path}: no <worldbody> and no top-level <body> to convert")
     return model
@@ -183,14 +186,16 @@ def _read_assets(asset: etree._Element, model: _Model) -> None:
         source = Path(mesh.get("_source") or model.path)
         file = mesh.get("file")
         if not file:
-            raise ObjectFileError(f"{source}: <mesh name={mesh.get('name')!r}> has no file (line {mesh.sourceline})")
+            raise ObjectFileError(
+                f"{source}: <mesh name={mesh.get('name')!r}> has no file (line {mesh.sourceline})")
         name = mesh.get("name") or Path(file).stem
         attrs = {**model.defaults.get(mesh.get("class") or "main", {}).get("mesh", {}), **mesh.attrib}
         scale = _floats(attrs.get("scale", "1 1 1"), f"{source}: mesh {name!r} scale", 3)[:3]
         found = next((d / file for d in _mesh_dirs(model, source) if (d / file).is_file()), None)
         if found is None:
             looked = ", ".join(str(d) for d in _mesh_dirs(model, source)[:4])
-            raise ObjectFileError(f"{source}: mesh {name!r}: file {file!r} not found (looked in {looked}, ...)")
+            raise ObjectFileError(
+                f"{source}: mesh {name!r}: file {file!r} not found (looked in {looked}, ...)")
         model.meshes[name] = (found.resolve(), scale)
     for material in asset.findall("material"):
         if material.get("name"):
@@ -223,6 +228,7 @@ class _Converter:
         self.names: set[str] = set()
         self.movable: list[str] = []
         self.counter = 0
+        self.unnamed = 0
 
     # ---------------------------------------------------------------- helpers
     def attrs(self, elem: etree._Element, childclass: str | None) -> dict[str, str]:
@@ -235,7 +241,8 @@ class _Converter:
 
     def where(self, elem: etree._Element) -> str:
         name = elem.get("name")
-        return f"{elem.get('_source')}: <{elem.tag}{' name=' + repr(name) if name else ''}> (line {elem.sourceline})"
+        label = f" name={name!r}" if name else ""
+        return f"{elem.get('_source')}: <{elem.tag}{label}> (line {elem.sourceline})"
 
     def rotation(self, a: dict[str, str], where: str) -> np.ndarray:
         """The rotation matrix of an element's orientation attributes."""
@@ -304,7 +311,8 @@ class _Converter:
             vis.append(f"    <visual name={quoteattr(name)}>{origin}<geometry>{shape[0]}</geometry>"
                        f"<material name={quoteattr(mat)}><color rgba={quoteattr(rgba)}/></material></visual>")
         if int(float(a.get("contype", "1"))) or int(float(a.get("conaffinity", "1"))):
-            col.append(f"    <collision name={quoteattr(name)}>{origin}<geometry>{shape[0]}</geometry></collision>")
+            col.append(f"    <collision name={quoteattr(name)}>{origin}<geometry>{shape[0]}</geometry>"
+                       "</collision>")
             volume, inertia_unit = shape[1], shape[2]
             mass = float(a["mass"]) if "mass" in a else float(a.get("density", self.density)) * volume
             body_mass.append((mass, pose, inertia_unit))
@@ -354,20 +362,23 @@ class _Converter:
         raise ObjectFileError(f"{where}: unknown geom type {gtype!r}")
 
     # ---------------------------------------------------------------- bodies
-    def body(self, elem: etree._Element, parent_link: str, parent_abs: np.ndarray, body_abs_parent: np.ndarray,
-             childclass: str | None, lines: list[str]) -> None:
+    def body(self, elem: etree._Element, parent_link: str, parent_abs: np.ndarray,
+             body_abs_parent: np.ndarray, childclass: str | None, lines: list[str]) -> None:
         """Write one body (its links and joints), then its children. ``parent_abs`` is the parent
         link's frame and ``body_abs_parent`` the parent body's frame, both in the root frame."""
         a = self.attrs(elem, childclass)
         where = self.where(elem)
         cls = elem.get("childclass") or childclass
         body_abs = body_abs_parent @ self.frame(a, where)
-        base_name = elem.get("name") or f"body{len(self.links)}"
+        if elem.get("name"):
+            base_name = elem.get("name")
+        else:
+            base_name, self.unnamed = f"body{self.unnamed}", self.unnamed + 1
         joints = [j for j in elem if isinstance(j.tag, str) and j.tag in ("joint", "freejoint")]
         link_abs, link_name, prev = body_abs, None, parent_link
         prev_abs = parent_abs
         movable = []
-        for k, joint in enumerate(joints):
+        for joint in joints:
             ja = self.attrs(joint, cls)
             jtype = "free" if joint.tag == "freejoint" else ja.get("type", "hinge")
             if jtype in ("free", "ball"):
@@ -388,7 +399,8 @@ class _Converter:
             if not last:
                 self.write_link(lines, link_name, [], [], [])
             jname = self.unique(joint.get("name") or f"{base_name}_joint{k}")
-            self.write_movable(lines, joint, ja, jtype, jname, prev, link_name, np.linalg.inv(prev_abs) @ link_abs)
+            self.write_movable(lines, joint, ja, jtype, jname, prev, link_name,
+                               np.linalg.inv(prev_abs) @ link_abs)
             prev, prev_abs = link_name, link_abs
         to_link = np.linalg.inv(link_abs) @ body_abs
         vis, col, masses = [], [], []
@@ -406,12 +418,12 @@ class _Converter:
     def write_joint(self, lines: list[str], name: str, jtype: str, parent: str, child: str,
                     origin: np.ndarray, extra: str = "") -> None:
         self.joints.append(name)
-        lines.append(f"  <joint name={quoteattr(name)} "
-                     f"type={quoteattr(jtype)}><parent link={quoteattr(parent)}/><child link={quoteattr(child)}/>"
+        lines.append(f"  <joint name={quoteattr(name)} type={quoteattr(jtype)}>"
+                     f"<parent link={quoteattr(parent)}/><child link={quoteattr(child)}/>"
                      f"{_origin(origin)}{extra}</joint>")
 
-    def write_movable(self, lines: list[str], joint: etree._Element, ja: dict[str, str], jtype: str, name: str,
-                      parent: str, child: str, origin: np.ndarray) -> None:
+    def write_movable(self, lines: list[str], joint: etree._Element, ja: dict[str, str], jtype: str,
+                      name: str, parent: str, child: str, origin: np.ndarray) -> None:
         where = self.where(joint)
         axis = _floats(ja.get("axis", "0 0 1"), where, 3)[:3]
         if np.linalg.norm(axis) < 1e-9:
@@ -444,9 +456,9 @@ class _Converter:
         self.links.append(name)
         mass, com, inertia = _inertial(masses, inertial, to_link, self)
         lines.append(f"  <link name={quoteattr(name)}>")
-        lines.append(f"    <inertial>{_origin_xyz(com)}<mass value=\"{mass:.9g}\"/>"
-                     f"<inertia ixx=\"{inertia[0, 0]:.9g}\" ixy=\"{inertia[0, 1]:.9g}\" ixz=\"{inertia[0, 2]:.9g}\" "
-                     f"iyy=\"{inertia[1, 1]:.9g}\" iyz=\"{inertia[1, 2]:.9g}\" izz=\"{inertia[2, 2]:.9g}\"/></inertial>")
+        terms = " ".join(f'i{a}="{inertia[i, j]:.9g}"' for a, (i, j) in _INERTIA_TERMS.items())
+        lines.append(f'    <inertial>{_origin_xyz(com)}<mass value="{mass:.9g}"/>'
+                     f"<inertia {terms}/></inertial>")
         lines += vis + col
         lines.append("  </link>")
 
@@ -479,7 +491,8 @@ def _inertial(masses: list, inertial: etree._Element | None, to_link: np.ndarray
             f = _floats(a["fullinertia"], where, 6)
             local = np.array([[f[0], f[3], f[4]], [f[3], f[1], f[5]], [f[4], f[5], f[2]]])
         else:
-            local = np.diag(_floats(a.get("diaginertia", f"{MIN_INERTIA} {MIN_INERTIA} {MIN_INERTIA}"), where, 3)[:3])
+            diag = a.get("diaginertia", f"{MIN_INERTIA} {MIN_INERTIA} {MIN_INERTIA}")
+            local = np.diag(_floats(diag, where, 3)[:3])
         rot = frame[:3, :3]
         return mass, frame[:3, 3], rot @ local @ rot.T
     if not masses:
@@ -508,7 +521,9 @@ def _fmt(values: np.ndarray) -> str:
 
 
 def _origin(mat: np.ndarray) -> str:
-    rpy = Rotation.from_matrix(mat[:3, :3]).as_euler("xyz")  # URDF rpy: fixed axes x, y, z
+    with warnings.catch_warnings():  # at gimbal lock scipy folds the roll into the yaw, still exact
+        warnings.simplefilter("ignore", UserWarning)
+        rpy = Rotation.from_matrix(mat[:3, :3]).as_euler("xyz")  # URDF rpy: fixed axes x, y, z
     return f'<origin xyz="{_fmt(mat[:3, 3])}" rpy="{_fmt(rpy)}"/>'
 
 

@@ -12,10 +12,11 @@ is).
 
 from __future__ import annotations
 
+import atexit
 import dataclasses
 import functools
-import hashlib
-import os
+import shutil
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -59,13 +60,10 @@ def _joint_type(joint: Any) -> str:
     return jtype[0] if isinstance(jtype, (list, tuple)) else str(jtype)
 
 
-def _cache_dir(path: Path, options: tuple) -> Path:
-    root = Path(os.environ.get("CAPT_CACHE_DIR", Path.home() / ".cache" / "capt_env")) / "objects"
-    stat = path.stat()
-    ident = repr((str(path.resolve()), stat.st_mtime_ns, stat.st_size, options))
-    key = hashlib.sha1(ident.encode()).hexdigest()
-    out = root / f"{path.stem}-{key[:12]}"
-    out.mkdir(parents=True, exist_ok=True)
+def _cache_dir(path: Path) -> Path:
+    """A fresh folder for this process's rewritten copy of ``path`` (removed at exit)."""
+    out = Path(tempfile.mkdtemp(prefix=f"capt_{path.stem}_"))
+    atexit.register(shutil.rmtree, out, True)
     return out
 
 
@@ -158,7 +156,7 @@ def prepare_urdf(path: Path, out_dir: Path) -> PreparedFile:
 def _prepare_cached(path: str, mtime_ns: int, visual_groups: tuple[int, ...], mjcf_angle: str,
                     density: float | None) -> PreparedFile:
     src = Path(path)
-    out_dir = _cache_dir(src, (visual_groups, mjcf_angle, density))
+    out_dir = _cache_dir(src)
     suffix = src.suffix.lower()
     if suffix in URDF_SUFFIXES:
         return prepare_urdf(src, out_dir)
@@ -174,7 +172,7 @@ def _prepare_cached(path: str, mtime_ns: int, visual_groups: tuple[int, ...], mj
 def prepare_object_file(path: str | Path, visual_groups: tuple[int, ...] = (0, 1, 2),
                         mjcf_angle: str = "auto", density: float | None = None) -> PreparedFile:
     """Check a URDF (``.urdf``) or MJCF (``.xml``/``.mjcf``, full model or included fragment) file
-    and write the URDF the simulator loads (cached per file version and options). ``density``
+    and write the URDF the simulator loads (once per process, file version and options). ``density``
     (kg/m^3) is an MJCF file's density for geoms without a mass (a URDF's is set at loading).
 
     :raises FileNotFoundError: if ``path`` does not exist.
