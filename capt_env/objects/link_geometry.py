@@ -3,8 +3,8 @@
 Written by hand because ManiSkill's ``trimesh_utils`` builds cylinder and capsule meshes along z
 while SAPIEN's primitives lie along x, which turns every cylinder and capsule by 90 degrees; here
 each primitive's unit mesh (SAPIEN's own vertices) is scaled by its sizes, so the geometry is
-exactly what the cameras see. Links without any shape (frames for a latch or a handle) give empty
-arrays instead of failing.
+exactly what the cameras see (and collision shapes likewise). Links without any shape (frames for
+a latch or a handle) give empty arrays instead of failing.
 """
 
 from __future__ import annotations
@@ -30,10 +30,7 @@ def _pose_matrix(pose: object) -> np.ndarray:
 
 
 def _capsule_along_x(radius: float, half_length: float) -> tuple[np.ndarray, np.ndarray]:
-    mesh = trimesh.creation.capsule(height=2 * half_length, radius=radius, count=[12, 12])
-    rot = trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0])  # z -> x
-    mesh.apply_transform(rot)
-    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    return _along_x(trimesh.creation.capsule(height=2 * half_length, radius=radius, count=[12, 12]))
 
 
 def shape_meshes(shape: sr.RenderShape) -> list[ShapeMesh]:
@@ -59,6 +56,40 @@ def shape_meshes(shape: sr.RenderShape) -> list[ShapeMesh]:
         verts = np.asarray(verts, dtype=np.float64).reshape(-1, 3)
         out.append(ShapeMesh(name=name, vertices=verts @ mat[:3, :3].T + mat[:3, 3],
                              faces=np.asarray(faces, dtype=np.int64).reshape(-1, 3)))
+    return out
+
+
+def _along_x(mesh: trimesh.Trimesh) -> tuple[np.ndarray, np.ndarray]:
+    mesh.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))  # z -> x
+    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
+
+
+def collision_shape_meshes(link: object) -> list[ShapeMesh]:
+    """Every collision shape of a ManiSkill ``Link`` (first sub-scene) as a mesh in the link frame;
+    PhysX capsules and cylinders lie along x, as the render shapes do."""
+    import sapien.physx as px
+
+    out = []
+    for shape in link._objs[0].get_collision_shapes():
+        if isinstance(shape, px.PhysxCollisionShapeBox):
+            mesh = trimesh.creation.box(extents=2 * np.asarray(shape.half_size))
+            verts, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+        elif isinstance(shape, px.PhysxCollisionShapeCapsule):
+            verts, faces = _capsule_along_x(float(shape.radius), float(shape.half_length))
+        elif isinstance(shape, px.PhysxCollisionShapeCylinder):
+            verts, faces = _along_x(trimesh.creation.cylinder(radius=float(shape.radius),
+                                                              height=2 * float(shape.half_length)))
+        elif isinstance(shape, px.PhysxCollisionShapeSphere):
+            mesh = trimesh.creation.icosphere(radius=float(shape.radius), subdivisions=2)
+            verts, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+        elif isinstance(shape, (px.PhysxCollisionShapeConvexMesh, px.PhysxCollisionShapeTriangleMesh)):
+            verts = np.asarray(shape.vertices, dtype=np.float64) * np.asarray(shape.scale)
+            faces = np.asarray(shape.get_triangles())
+        else:  # planes
+            continue
+        mat = _pose_matrix(shape.local_pose)
+        verts = np.asarray(verts) @ mat[:3, :3].T + mat[:3, 3]
+        out.append(ShapeMesh("", verts, np.asarray(faces).reshape(-1, 3)))
     return out
 
 

@@ -179,3 +179,27 @@ def test_urdf_friction_becomes_a_capped_drive_and_part_mass_is_set(tmp_path: Pat
         assert float(env.object.target_child_link.mass[0]) == pytest.approx(0.25, rel=1e-4)
     finally:
         env.close()
+
+
+def test_cylinder_and_capsule_geometry_lies_along_the_urdf_axis(tmp_path: Path) -> None:
+    """ManiSkill's trimesh conversion turns SAPIEN's x-axis cylinders and capsules by 90 degrees;
+    the task's own geometry must not: a 30 cm bar along the door's z stays 30 cm tall."""
+    from capt_env.objects.link_geometry import collision_shape_meshes, link_vertices
+
+    text = cabinet_urdf().replace(
+        '<visual name="pull_bar"><origin xyz="-0.03 0.35 0"/><geometry><box size="0.02 0.02 0.15"/>'
+        "</geometry></visual>",
+        '<visual name="pull_bar"><origin xyz="-0.03 0.35 0"/><geometry><cylinder radius="0.01" length="0.3"/>'
+        '</geometry></visual><collision><origin xyz="-0.03 0.35 0"/><geometry><capsule radius="0.01" '
+        'length="0.3"/></geometry></collision>')
+    assert "cylinder" in text
+    env = make(tmp_path, text)
+    try:
+        door = env.object.target_child_link
+        verts = link_vertices(door)
+        bar = verts[verts[:, 0] < -0.015]
+        assert bar[:, 2].max() - bar[:, 2].min() == pytest.approx(0.3, abs=1e-3)
+        capsule = min(collision_shape_meshes(door), key=lambda m: m.vertices[:, 0].mean())
+        assert np.ptp(capsule.vertices[:, 2]) == pytest.approx(0.32, abs=2e-3)  # 0.3 + two 1 cm caps
+    finally:
+        env.close()
