@@ -73,3 +73,13 @@ def test_inspect_object_reports_joints_reach_and_writes_a_picture(drawer_urdf: P
     assert report["grasp_from"] == "geometry" and report["reach"]["ok"]
     assert [j["closed_at"] for j in report["joints"]] == ["lower", "lower"]
     assert abs(report["front_azimuth_rad"]) == pytest.approx(np.pi)  # procedural fronts face -x
+
+
+def test_demo_estimates_an_object_file(drawer_urdf: Path, tmp_path: Path,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "demo.json"
+    assert main(["demo", "--object", str(drawer_urdf), "--joint", "drawer_1_slide", "--no-policy",
+                 "--out", str(tmp_path / "demo"), "--json", str(out)]) == 0
+    assert "small_drawer_episode0 (user file)" in capsys.readouterr().out
+    (row,) = json.loads(out.read_text())["episodes"]
+    assert row["object"] == "small_drawer" and Path(row["png"]).is_file()

@@ -203,3 +203,15 @@ def test_cylinder_and_capsule_geometry_lies_along_the_urdf_axis(tmp_path: Path) 
         assert np.ptp(capsule.vertices[:, 2]) == pytest.approx(0.32, abs=2e-3)  # 0.3 + two 1 cm caps
     finally:
         env.close()
+
+
+def test_a_continuous_joint_loads_with_a_full_turn_of_range(tmp_path: Path) -> None:
+    text = cabinet_urdf().replace('type="revolute"', 'type="continuous"').replace(
+        '<limit lower="0.0" upper="1.5" effort="10" velocity="1"/>', '<limit effort="10" velocity="1"/>')
+    assert 'type="continuous"' in text
+    env = make(tmp_path, text)
+    try:
+        assert env.object.limits.tolist() == [[0.0, pytest.approx(2 * np.pi)]]
+        env.reset(seed=1)
+    finally:
+        env.close()
