@@ -1,8 +1,10 @@
-"""``capt generate``: render a labelled single-view cloud dataset of one category (see dataset.generator)."""
+"""``capt generate``: render a labelled single-view cloud dataset of one category or user file (see
+dataset.generator); with several files (``--objects``), one dataset per file under ``OUT/LABEL``."""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from capt_env.commands.json_output import write_json
 from capt_env.commands.object_targets import add_object_arguments, object_targets
@@ -37,21 +39,23 @@ def run(args: argparse.Namespace) -> int:
         changes["category"] = args.category
     if args.seed is not None:
         changes["seed"] = args.seed
+    jobs = [(dataclasses.replace(cfg, **changes), args.out)]
     if args.object or args.objects:
         if args.category:
-            raise SystemExit("give either --category or one user file (--object / --objects)")
+            raise SystemExit("give either --category or user files (--object / --objects)")
         args.categories = []
         files = object_targets(args)
-        if len(files) != 1:
-            raise SystemExit(f"capt generate renders one object per dataset; got {[t.label for t in files]}")
-        changes["object"] = dict(files[0].task)
-        changes["category"] = files[0].label
-    cfg = dataclasses.replace(cfg, **changes)
-    cfg.validate()
-    result = generate(cfg, args.out, workers=args.workers)
-    rate = result["samples_per_second"]
-    print(f"{cfg.category}: {result['counts']} in {args.out}; rendered {result['rendered_now']} now "
-          f"with {result['workers']} workers in {result['seconds']:.1f} s"
-          + (f" ({rate:.2f} samples/s)" if rate else "") + f"; {result['skipped_shards']} shards existed")
-    write_json(args.json, result)
+        # one dataset per file: OUT itself for one file, OUT/LABEL for several
+        jobs = [(dataclasses.replace(cfg, **changes, object=dict(t.task), category=t.label),
+                 args.out if len(files) == 1 else str(Path(args.out) / t.label)) for t in files]
+    results = []
+    for job_cfg, out in jobs:
+        job_cfg.validate()
+        result = generate(job_cfg, out, workers=args.workers)
+        rate = result["samples_per_second"]
+        print(f"{job_cfg.category}: {result['counts']} in {out}; rendered {result['rendered_now']} now "
+              f"with {result['workers']} workers in {result['seconds']:.1f} s"
+              + (f" ({rate:.2f} samples/s)" if rate else "") + f"; {result['skipped_shards']} shards existed")
+        results.append(result)
+    write_json(args.json, results[0] if len(results) == 1 else {"datasets": results})
     return 0

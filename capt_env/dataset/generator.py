@@ -9,7 +9,7 @@ Layout of an output directory::
 Keys of a shard (S samples, N = ``num_points``, J = ``MAX_JOINTS``; world frame, metres, radians):
 
     points (S,N,3) float32       object points only (robot, table and background removed by labels)
-    part_labels (S,N) int64      link index of each point (0 = base)
+    part_labels (S,N) int64      part of each point (0 = base, k + 1 = moved by joint k)
     joint_types (S,J) int64      0 revolute, 1 prismatic (-1 in unused slots)
     joint_dirs (S,J,3) float32   unit axis direction, +state opens
     joint_pivots (S,J,3) float32 the point of the axis closest to the cloud's centroid

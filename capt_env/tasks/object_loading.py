@@ -47,7 +47,7 @@ class LoadedObject:
     limits: np.ndarray  # (J, 2) task-frame limits: (0, range), radians or metres; 0 = closed
     closed_qpos: np.ndarray  # (J,) simulator joint position of each joint's closed limit
     open_sign: np.ndarray  # (J,) +1 where opening raises the simulator position, -1 where it lowers it
-    child_parts: list[int]  # part label (link index) moved by each joint
+    child_parts: list[int]  # part label moved by each joint: k + 1 for joint k (see link_parts)
     target_joint: int
     grasp_link: Link
     grasp_local: np.ndarray  # (3,) grasp point in grasp_link's frame, metres
@@ -114,8 +114,7 @@ def _joint_table(art: Articulation) -> JointTable:
     """Movable joints, their names, type ids, simulator limits (J, 2) and child part labels."""
     joints = list(art.active_joints)
     names = [j.name for j in joints]
-    link_names = [link.name for link in art.links]
-    child_parts = [link_names.index(j.child_link.name) for j in joints]
+    child_parts = [k + 1 for k in range(len(joints))]  # see link_parts
     type_ids = [_joint_type_id(j) for j in joints]
     limits = np.array([_limits(j, t) for j, t in zip(joints, type_ids, strict=True)], dtype=np.float64)
     return joints, names, type_ids, limits, child_parts
@@ -140,7 +139,7 @@ def _load_procedural(scene: Any, cfg: TaskConfig, rng: np.random.RandomState,
         grasp_local=np.asarray(spec.grasp_point, dtype=np.float64) * cfg.scale,
         aabb=(lo * cfg.scale, hi * cfg.scale),
         front_yaw=float(math.pi - math.atan2(spec.front[1], spec.front[0])),  # spec.front: outward normal
-        segmentation_lut=_segmentation_lut(links),
+        segmentation_lut=_segmentation_lut(art, joints),
     )
 
 
@@ -164,13 +163,12 @@ def _load_user_file(scene: Any, cfg: TaskConfig) -> LoadedObject:
     front = cfg.front_yaw_radians()
     if front is None:
         front = _guess_front_azimuth(art, grasp_link, grasp, aabb)
-    links = list(art.links)
     return LoadedObject(
         articulation=art, name="object", category="user", instance_id=-1, spec=None,
         joints=joints, joint_names=names, joint_type_ids=type_ids, limits=_task_limits(sim_limits),
         closed_qpos=closed_qpos, open_sign=open_sign, child_parts=child_parts, target_joint=target,
         grasp_link=grasp_link, grasp_local=grasp.point, aabb=aabb, front_yaw=float(math.pi - front),
-        segmentation_lut=_segmentation_lut(links), warnings=tuple(info["warnings"]),
+        segmentation_lut=_segmentation_lut(art, joints), warnings=tuple(info["warnings"]),
         grasp_source=grasp.source,
     )
 
@@ -360,10 +358,25 @@ def _limits(joint: ArticulationJoint, type_id: int) -> tuple[float, float]:
     return lo, hi
 
 
-def _segmentation_lut(links: list[Link]) -> torch.Tensor:
+def link_parts(art: Articulation, joints: list[ArticulationJoint]) -> list[int]:
+    """The part label of every link (``art.links`` order): 0 for links fixed to the root, ``k + 1``
+    for the links movable joint ``k`` moves and that are fixed to its child (links joined by fixed
+    joints, such as a handle or a frame without geometry, are one part, as the eye sees them)."""
+    part_of_child = {j.child_link.name: k + 1 for k, j in enumerate(joints)}
+    parts = []
+    for link in art.links:
+        cur = link
+        while cur is not None and cur.name not in part_of_child:
+            cur = cur.joint.parent_link
+        parts.append(0 if cur is None else part_of_child[cur.name])
+    return parts
+
+
+def _segmentation_lut(art: Articulation, joints: list[ArticulationJoint]) -> torch.Tensor:
+    links = list(art.links)
     ids = [int(link.per_scene_id.reshape(-1)[0]) for link in links]
     lut = torch.full((1, max(ids) + 1), -1, dtype=torch.long)
-    for part, seg_id in enumerate(ids):
+    for part, seg_id in zip(link_parts(art, joints), ids, strict=True):
         lut[0, seg_id] = part
     return lut
 

@@ -30,7 +30,9 @@ the closed state, and its child link is at rest.
 (a point on the axis: the joint frame origin), ``joint_state`` (rad or m), ``joint_limits``,
 ``joint_child_part``, plus ``target_joint``, ``open_fraction``, ``grasp_point``, ``success``.
 In ``pointcloud`` mode the observation's ``pointcloud`` dict also carries ``part_label``: for each
-point the index of the object link it lies on (0 = base), or -1 for anything that is not the object.
+point the object part it lies on (0 = everything fixed to the base, ``k + 1`` = the part movable
+joint ``k`` moves, links joined by fixed joints counted as one part), or -1 for anything that is not
+the object.
 """
 
 from __future__ import annotations

@@ -61,6 +61,9 @@ def test_a_link_without_geometry_loads_and_the_task_steps(tmp_path: Path) -> Non
         env.reset(seed=0)
         env.step(np.zeros(env.action_space.shape, dtype=np.float32))
         assert env.object.grasp_source == "name"
+        # the frame fixed to the door is part of the door: parts are 0 (base) and 1 (joint 0)
+        lut = env.object.segmentation_lut[0]
+        assert sorted(set(lut[lut >= 0].tolist())) == [0, 1] and env.object.child_parts == [1]
     finally:
         env.close()
 
