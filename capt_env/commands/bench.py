@@ -72,7 +72,7 @@ def measure_with_capt(category: str, every_k: int, steps: int, width: int, seed:
     for _ in tqdm(range(steps), desc=f"capt every {every_k}", leave=False):
         _, _, terminated, truncated, info = env.step(env.action_space.sample())
         if info.get("perception_ran"):
-            latencies.append(float(info["perception_latency_ms"]))
+            latencies.append(float(env.last_perception_latency_ms))
         if terminated or truncated:
             env.reset()
     elapsed = time.perf_counter() - t

@@ -5,9 +5,11 @@ the world-frame cloud (``isolation.mode``), downsample them to ``num_points`` (s
 target joint with the configured source, and keep the estimate. Every step the observation is the
 proprioception of that step plus the latest estimate (layout: :mod:`capt_env.wrappers.joint_observation`).
 
-``info`` gains ``perception_ran`` (bool, perception ran on this step), ``perception_latency_ms``
-(float, isolation + estimate time of this step, 0.0 if it did not run) and ``object_points``
-(int, isolated object points of the last run; -1 when the source reads no cloud).
+``info`` gains ``perception_ran`` (bool, perception ran on this step) and ``object_points`` (int,
+isolated object points of the last run; -1 when the source reads no cloud). The wall-clock time of
+the last run (isolation + estimate, ms) is the attribute ``last_perception_latency_ms``, not an
+``info`` entry, so that a step's info depends only on the seed and the actions (Gymnasium's
+determinism check).
 Oracle sources work with any obs mode; ``capt`` needs ``obs_mode="pointcloud"``.
 """
 
@@ -63,6 +65,7 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self._estimate: JointAxisEstimate | None = None
         self._steps = 0
         self._object_points = -1
+        self.last_perception_latency_ms = 0.0  # wall-clock ms of the last perception run
 
     @property
     def estimate(self) -> JointAxisEstimate | None:
@@ -133,8 +136,9 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         return flatten(obs) if self.config.obs_format == "flat" else obs
 
     def _info(self, info: dict, ran: bool, latency: float) -> dict:
+        if ran:
+            self.last_perception_latency_ms = float(latency)
         out = dict(info)
         out["perception_ran"] = bool(ran)
-        out["perception_latency_ms"] = float(latency)
         out["object_points"] = int(self._object_points)
         return out
