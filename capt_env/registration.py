@@ -1,15 +1,20 @@
 """Environment ids: ManiSkill-native batched ids and standard single-env Gymnasium ids.
 
 Two ids per object category ``Cat`` (Laptop, Oven, WashingMachine, Eyeglasses, DrawerCabinet,
-CabinetDoor, Scissors) plus a generic one taking ``category=`` or ``object=``:
+CabinetDoor) plus a generic one taking ``task={"category": ...}`` or ``task={"object": PATH}``:
 
 - ``CaptOpen<Cat>-v0`` / ``CaptOpenArticulated-v0``: a standard Gymnasium env (numpy arrays, no
-  batch dimension, CPU simulation), what SB3 and ``gymnasium.utils.env_checker`` expect.
+  batch dimension, CPU simulation), what SB3 and ``gymnasium.utils.env_checker`` expect. Episodes
+  are truncated after ``MAX_EPISODE_STEPS`` (the spec's ``max_episode_steps``; ``gym.make(id,
+  max_episode_steps=N)`` sets another limit). ``wrappers=[W, ...]`` applies ManiSkill or Gymnasium
+  wrappers (classes or callables ``env -> env``) to the ManiSkill env before it is unbatched, e.g.
+  ``mani_skill.utils.wrappers.FlattenRGBDObservationWrapper``.
 - ``CaptOpen<Cat>-ms-v0`` / ``CaptOpenArticulated-ms-v0``: the ManiSkill env itself (batched torch
   tensors; ``num_envs > 1`` and ``sim_backend="physx_cuda"`` on a GPU).
 
-``import capt_env`` registers them; ``gymnasium.make("capt_env:CaptOpenLaptop-v0")`` imports the
-package itself, so other projects need no import of their own.
+``gymnasium.make("capt_env:CaptOpenLaptop-v0")`` imports the package and registers the ids, so
+other projects need no import of their own (Gymnasium 1.x reads no plugin entry points);
+``import capt_env`` registers them too.
 """
 
 from __future__ import annotations
@@ -28,7 +33,6 @@ CATEGORY_ENV_NAMES = {
     "eyeglasses": "Eyeglasses",
     "drawer_cabinet": "DrawerCabinet",
     "cabinet_door": "CabinetDoor",
-    "scissors": "Scissors",
 }
 GENERIC_ID = "CaptOpenArticulated-v0"
 GENERIC_MS_ID = "CaptOpenArticulated-ms-v0"
@@ -67,15 +71,43 @@ def _copy_tree(x: Any) -> Any:
     return x
 
 
-def make_single_env(maniskill_id: str, **kwargs: Any) -> gym.Env:
-    """Create a ManiSkill id with one CPU env and unbatch it to plain numpy (``CPUGymWrapper``)."""
+_UNLIMITED = 10**9  # the inner ManiSkill limit (int32-safe); Gymnasium's TimeLimit from the spec truncates
+
+
+def make_single_env(maniskill_id: str, wrappers: list | tuple = (), **kwargs: Any) -> gym.Env:
+    """Create a ManiSkill id with one CPU env, apply ``wrappers`` to it, and unbatch it to plain
+    numpy (``CPUGymWrapper``). The episode limit is Gymnasium's (the registered 200 steps or the
+    ``max_episode_steps`` given to ``gym.make``), so ManiSkill's own limit is lifted here."""
     from mani_skill.utils.wrappers.gymnasium import CPUGymWrapper
 
     if kwargs.get("num_envs", 1) != 1:
         raise ValueError("the single-env ids take num_envs=1; use the '-ms-' ids for batched envs")
     kwargs.pop("num_envs", None)
-    env = gym.make(maniskill_id, num_envs=1, **kwargs)
+    _refuse_forked_child()
+    env = gym.make(maniskill_id, num_envs=1, max_episode_steps=_UNLIMITED, **kwargs)
+    for wrapper in wrappers:
+        if not callable(wrapper):
+            raise TypeError(f"wrappers must be wrapper classes or callables env -> env, got {wrapper!r}")
+        env = wrapper(env)
     return OwnedArrays(CPUGymWrapper(env))
+
+
+_SIMULATOR_PID: int | None = None
+
+
+def _refuse_forked_child() -> None:
+    """Fail fast in a process forked from one that already built a simulator: SAPIEN's threads and
+    device handles do not survive ``fork`` and the child would hang (Gymnasium's async vector env
+    forks by default on Linux after building one env in the parent)."""
+    import os
+
+    global _SIMULATOR_PID
+    if _SIMULATOR_PID is not None and _SIMULATOR_PID != os.getpid():
+        raise RuntimeError(
+            "capt_env envs cannot be created in a forked process after the parent built one; use the "
+            "spawn start method, e.g. gym.make_vec(id, n, vectorization_mode='async', "
+            "vector_kwargs={'context': 'spawn'}) or SB3's SubprocVecEnv(..., start_method='spawn')")
+    _SIMULATOR_PID = os.getpid()
 
 
 def register_envs() -> None:
@@ -90,10 +122,10 @@ def register_envs() -> None:
 
     register_env(GENERIC_MS_ID, max_episode_steps=MAX_EPISODE_STEPS)(OpenArticulatedEnv)
     gym.register(GENERIC_ID, entry_point=make_single_env, kwargs={"maniskill_id": GENERIC_MS_ID},
-                 disable_env_checker=True)
+                 max_episode_steps=MAX_EPISODE_STEPS, disable_env_checker=True)
     for category in CATEGORIES:
         ms_id = env_id(category, maniskill=True)
         register_env(ms_id, max_episode_steps=MAX_EPISODE_STEPS, category=category)(OpenArticulatedEnv)
         gym.register(env_id(category), entry_point=make_single_env, kwargs={"maniskill_id": ms_id},
-                     disable_env_checker=True)
+                     max_episode_steps=MAX_EPISODE_STEPS, disable_env_checker=True)
     _registered = True

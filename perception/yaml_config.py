@@ -109,7 +109,11 @@ def from_dict(cls: type[T], data: Any, where: str = "config") -> T:
         raise ConfigError(f"{where}: {err}") from err
     validate = getattr(obj, "validate", None)
     if callable(validate):
-        validate()
+        try:
+            validate()
+        except ConfigError as err:  # name the file or mapping the bad value came from
+            message = str(err)
+            raise ConfigError(message if message.startswith(f"{where}") else f"{where}: {message}") from None
     return obj
 
 
@@ -120,7 +124,7 @@ def load_yaml(cls: type[T], path: str | Path) -> T:
         raise ConfigError(f"config file not found: {path}")
     with path.open() as fh:
         data = yaml.safe_load(fh)
-    return from_dict(cls, data, where=path.name)
+    return from_dict(cls, data, where=str(path))
 
 
 def to_dict(obj: Any) -> dict:

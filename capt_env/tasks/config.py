@@ -160,9 +160,11 @@ class TaskConfig:
         for name in ("target_init_fraction", "other_init_fraction"):
             lo, hi = getattr(self, name)
             require(0.0 <= lo <= hi <= 1.0, f"{name} must satisfy 0 <= low <= high <= 1, got {(lo, hi)}")
-        require(0.0 < self.success_fraction <= 1.0, "success_fraction must be in (0, 1]")
-        require(self.yaw_noise >= 0, "yaw_noise must be >= 0")
-        require(all(n >= 0 for n in self.object_xy_noise), "object_xy_noise must be >= 0")
+        require(0.0 < self.success_fraction <= 1.0,
+                f"success_fraction must be in (0, 1], got {self.success_fraction}")
+        require(self.yaw_noise >= 0, f"yaw_noise must be >= 0, got {self.yaw_noise}")
+        require(all(n >= 0 for n in self.object_xy_noise),
+                f"object_xy_noise must be >= 0, got {self.object_xy_noise}")
         require(self.object_xy is None or len(self.object_xy) == 2,
                 f"object_xy must be [x, y] metres or null, got {self.object_xy}")
         require(len(self.cameras) >= 1, "at least one camera is needed")

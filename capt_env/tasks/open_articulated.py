@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -100,18 +101,34 @@ class OpenArticulatedEnv(BaseEnv):
         **kwargs: Any,
     ) -> None:
         overrides = {k: kwargs.pop(k) for k in list(kwargs) if k in _TASK_FIELDS}
+        where = "task"
+        if isinstance(task, (str, Path)):  # a YAML file of TaskConfig keys
+            where = str(task)
+            task = _read_task_yaml(Path(task))
         if isinstance(task, TaskConfig):
             base = dataclasses.asdict(task)
             base["cameras"] = list(task.cameras)
         else:
             base = dict(task or {})
-        base.update({k: v for k, v in overrides.items() if v is not None})
-        self.task_config: TaskConfig = from_dict(TaskConfig, base, where="task")
+        for key, value in overrides.items():  # the id's own keys (a category id's category)
+            if value is None:
+                continue
+            if key in base and base[key] is not None and base[key] != value:
+                raise ValueError(f"{where}: {key}={base[key]!r} conflicts with this env id's "
+                                 f"{key}={value!r}; use {GENERIC_NAME} for any {key}")
+            if key == "category" and base.get("object") is not None:
+                raise ValueError(f"{where}: object={base['object']!r} on a category id; use {GENERIC_NAME} "
+                                 "for user files")
+            base[key] = value
+        self.task_config: TaskConfig = from_dict(TaskConfig, base, where=where)
         self.robot_init_qpos_noise = robot_init_qpos_noise
         self.object: LoadedObject | None = None
         if reconfiguration_freq is None:
             reconfiguration_freq = 1 if num_envs == 1 else 0
         kwargs.setdefault("control_mode", DEFAULT_CONTROL_MODE)
+        if "render_backend" not in kwargs and not torch.cuda.is_available():
+            kwargs["render_backend"] = "cpu"  # ManiSkill asks for CUDA first and warns on every env
+        self._entropy_seed_pending = False
         with translate_render_error():
             super().__init__(
                 *args,
@@ -120,8 +137,13 @@ class OpenArticulatedEnv(BaseEnv):
                 num_envs=num_envs,
                 **kwargs,
             )
+        self._entropy_seed_pending = True  # the constructor's own reset used ManiSkill's fixed seed
 
     def reset(self, seed: int | list[int] | None = None, options: dict | None = None) -> tuple[Any, dict]:
+        if seed is None and self._entropy_seed_pending:
+            # Gymnasium's rule: the first unseeded reset draws fresh entropy, so processes differ
+            seed = int(np.random.SeedSequence().entropy % (2**31))
+        self._entropy_seed_pending = False
         if seed is not None:
             # Gymnasium's own generator (env.np_random), seeded like ManiSkill's episode RNGs.
             first = int(seed[0]) if isinstance(seed, (list, tuple, np.ndarray)) else int(seed)
@@ -310,3 +332,16 @@ class OpenArticulatedEnv(BaseEnv):
 
 
 _TASK_FIELDS = {f.name for f in dataclasses.fields(TaskConfig)}
+GENERIC_NAME = "CaptOpenArticulated-v0"
+
+
+def _read_task_yaml(path: Path) -> dict:
+    """TaskConfig keys from a YAML file (validated with the file named in errors)."""
+    import yaml
+
+    if not path.is_file():
+        raise FileNotFoundError(f"task file not found: {path}")
+    raw = yaml.safe_load(path.read_text()) or {}
+    if not isinstance(raw, dict):
+        raise ValueError(f"{path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
+    return raw
