@@ -85,10 +85,20 @@ def load_checkpoint(path: str | Path, expected_model: Any = None) -> Checkpoint:
     """Read a checkpoint safely (``weights_only=True``). If ``expected_model`` (a ModelConfig) is given,
     the stored model config must equal it. Raises :class:`CheckpointError` naming the problem."""
     path = Path(path)
+    if path.is_dir():
+        raise CheckpointError(f"checkpoint {path} is a directory; give the .pt file in it "
+                              f"(e.g. {path}/best.pt)")
     if not path.is_file():
         raise CheckpointError(f"checkpoint not found: {path}")
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
+    except (RuntimeError, EOFError, OSError) as exc:
+        text = str(exc).lower()
+        if "zip" in text or "central directory" in text or isinstance(exc, (EOFError, OSError)):
+            first = str(exc).split(". ")[0]
+            raise CheckpointError(f"checkpoint {path} is truncated or corrupt ({path.stat().st_size} bytes); "
+                                  f"copy or save it again ({first})") from exc
+        raise CheckpointError(f"cannot read checkpoint {path}: {exc}") from exc
     except Exception as exc:  # noqa: BLE001 - any unpickling failure means an unusable file
         raise CheckpointError(f"cannot read checkpoint {path}: {exc}") from exc
     if not isinstance(payload, dict) or "format_version" not in payload:

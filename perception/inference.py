@@ -56,6 +56,20 @@ class ArticulationEstimate:
     latency_ms: float
 
 
+MIN_EXTENT = 1e-4
+"""m: the smallest extent an input cloud may span (identical points carry no shape)."""
+
+
+def checked_device(device: str | torch.device) -> torch.device:
+    """``device`` as a torch device, or a ValueError saying why it cannot be used here."""
+    dev = torch.device(device)
+    if dev.type == "cuda" and not torch.cuda.is_available():
+        build = "a CPU-only build" if torch.version.cuda is None else f"CUDA {torch.version.cuda}, no device"
+        raise ValueError(f"device {str(device)!r}: CUDA is not available (torch {torch.__version__}, "
+                         f"{build}); use device='cpu'")
+    return dev
+
+
 def check_points(points: np.ndarray, min_points: int = MIN_POINTS) -> np.ndarray:
     """Validate one input cloud; returns it as float64 (N, 3) or raises ValueError saying what is wrong."""
     if not isinstance(points, np.ndarray):
@@ -70,6 +84,10 @@ def check_points(points: np.ndarray, min_points: int = MIN_POINTS) -> np.ndarray
         raise ValueError(f"too few points: got {points.shape[0]}, need at least {min_points}")
     if not np.isfinite(points).all():
         raise ValueError("points contains NaN or inf values")
+    extent = float(np.ptp(points, axis=0).max())
+    if extent < MIN_EXTENT:
+        raise ValueError(f"degenerate cloud: its {points.shape[0]} points span {extent:.2g} m (need at "
+                         f"least {MIN_EXTENT} m); normalising it would divide by zero")
     return points.astype(np.float64)
 
 
@@ -129,7 +147,7 @@ class ArticulationEstimator:
                              f"validation); this one is {variant}")
         self.double_voting = config.double_voting if double_voting is None else double_voting
         self.config = config
-        self.device = torch.device(device)
+        self.device = checked_device(device)
         self.model = model.to(self.device).eval()
         self.voting_window = voting_window or (config.voting.w0, config.voting.w1)
         self.category = category
@@ -144,6 +162,7 @@ class ArticulationEstimator:
         """Load a checkpoint written by :func:`perception.checkpoint.save_checkpoint`
         (``double_voting`` and ``outlier_filter`` as in the constructor)."""
         ckpt = load_checkpoint(path)
+        device = checked_device(device)
         return cls(build_model(ckpt, device), ckpt.config, ckpt.voting_window, ckpt.category, device, seed,
                    double_voting, outlier_filter)
 
