@@ -1,13 +1,16 @@
 """The ``capt`` command line: one console script, one verb per job.
 
-Every verb prints a human summary and, with ``--json PATH``, writes its numbers as JSON. Verbs import
-their heavy dependencies lazily, so ``capt --help`` and ``capt doctor`` stay fast.
+Every verb prints a human summary and, with ``--json PATH``, writes its numbers as JSON. Only the
+chosen verb's module is imported, and verbs import their heavy dependencies lazily, so ``capt
+--help`` stays fast. Bad input (a missing file, a bad config value, an unknown category) is one line
+``capt VERB: error: ...`` and exit status 2, as argparse reports bad options.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 # verb -> (module under capt_env.commands, one-line help)
@@ -26,25 +29,54 @@ VERBS: dict[str, tuple[str, str]] = {
 }
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _add_verb(sub: argparse._SubParsersAction, verb: str, with_arguments: bool) -> None:
+    module, help_text = VERBS[verb]
+    p = sub.add_parser(verb, help=help_text, description=help_text,
+                       formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    if not with_arguments:
+        return
+    mod = importlib.import_module(f"capt_env.commands.{module}")
+    mod.add_arguments(p)
+    p.add_argument("--json", metavar="PATH", default=None, help="also write the numbers as JSON here")
+    p.set_defaults(_run=mod.run)
+
+
+def build_parser(verbs: list[str] | None = None) -> argparse.ArgumentParser:
+    """The ``capt`` parser; only the verbs in ``verbs`` (default: all) get their options, so that
+    ``capt --help`` and one verb's parsing import nothing else."""
     parser = argparse.ArgumentParser(prog="capt", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
-    for verb, (module, help_text) in VERBS.items():
-        mod = importlib.import_module(f"capt_env.commands.{module}")
-        p = sub.add_parser(verb, help=help_text, description=help_text)
-        mod.add_arguments(p)
-        p.add_argument("--json", metavar="PATH", default=None, help="also write the numbers as JSON here")
-        p.set_defaults(_run=mod.run)
+    chosen = set(VERBS) if verbs is None else set(verbs)
+    for verb in VERBS:
+        _add_verb(sub, verb, verb in chosen)
     return parser
 
 
+USER_ERRORS: tuple[type[BaseException], ...] = (FileNotFoundError, ValueError, KeyError)
+"""Exceptions a command raises for bad input (files, configs, values): reported in one line."""
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    verb = next((a for a in argv if not a.startswith("-")), None)
+    parser = build_parser([verb] if verb in VERBS else [])
+    args = parser.parse_args(argv)
     try:
         return int(args._run(args) or 0)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+    except SystemExit as exc:  # commands exit with a message for bad input
+        if isinstance(exc.code, str):
+            message = exc.code.removeprefix(f"capt {args.verb}: ")
+            print(f"capt {args.verb}: error: {message}", file=sys.stderr)
+            return 2
+        raise
+    except USER_ERRORS as exc:
+        if os.environ.get("CAPT_TRACEBACK"):
+            raise
+        print(f"capt {args.verb}: error: {exc} (CAPT_TRACEBACK=1 shows the traceback)", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -19,6 +19,7 @@ other projects need no import of their own (Gymnasium 1.x reads no plugin entry 
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import gymnasium as gym
@@ -110,22 +111,44 @@ def _refuse_forked_child() -> None:
     _SIMULATOR_PID = os.getpid()
 
 
+def make_maniskill_env(uid: str, **kwargs: Any) -> gym.Env:
+    """Entry point of the ``-ms-v0`` ids: the ManiSkill env ``uid`` (registered with ManiSkill on
+    first use, so that importing capt_env does not import the simulator)."""
+    from mani_skill.utils.registration import REGISTERED_ENVS, register
+
+    from capt_env.tasks.open_articulated import OpenArticulatedEnv
+
+    if uid not in REGISTERED_ENVS:
+        register(uid, OpenArticulatedEnv, max_episode_steps=MAX_EPISODE_STEPS)
+    return REGISTERED_ENVS[uid].make(**kwargs)
+
+
+def _register_maniskill_id(uid: str, **kwargs: Any) -> None:
+    """A Gymnasium registration like ManiSkill's ``register_env`` makes (its batched TimeLimit
+    wrapper included), without importing ManiSkill now."""
+    from gymnasium.envs.registration import WrapperSpec
+
+    gym.register(
+        uid, entry_point=functools.partial(make_maniskill_env, uid=uid), max_episode_steps=MAX_EPISODE_STEPS,
+        disable_env_checker=True, kwargs=kwargs,
+        additional_wrappers=(WrapperSpec("MSTimeLimit", "mani_skill.utils.registration:TimeLimitWrapper",
+                                         {"max_episode_steps": MAX_EPISODE_STEPS}),),
+    )
+
+
 def register_envs() -> None:
-    """Register every id with ManiSkill and Gymnasium (idempotent)."""
+    """Register every id with Gymnasium (idempotent; cheap: the simulator is imported on first use)."""
     global _registered
     if _registered:
         return
-    from mani_skill.utils.registration import register_env
-
     from capt_env.objects.registry import CATEGORIES
-    from capt_env.tasks.open_articulated import OpenArticulatedEnv
 
-    register_env(GENERIC_MS_ID, max_episode_steps=MAX_EPISODE_STEPS)(OpenArticulatedEnv)
+    _register_maniskill_id(GENERIC_MS_ID)
     gym.register(GENERIC_ID, entry_point=make_single_env, kwargs={"maniskill_id": GENERIC_MS_ID},
                  max_episode_steps=MAX_EPISODE_STEPS, disable_env_checker=True)
     for category in CATEGORIES:
         ms_id = env_id(category, maniskill=True)
-        register_env(ms_id, max_episode_steps=MAX_EPISODE_STEPS, category=category)(OpenArticulatedEnv)
+        _register_maniskill_id(ms_id, category=category)
         gym.register(env_id(category), entry_point=make_single_env, kwargs={"maniskill_id": ms_id},
                      max_episode_steps=MAX_EPISODE_STEPS, disable_env_checker=True)
     _registered = True

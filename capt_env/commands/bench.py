@@ -15,9 +15,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--category", default="laptop", help="object category (default: laptop)")
     parser.add_argument("--steps", type=int, default=200, help="random-action steps per obs mode")
     parser.add_argument("--resets", type=int, default=5, help="resets (each builds a new object)")
-    parser.add_argument("--obs-modes", nargs="+", default=["state", "pointcloud"])
+    parser.add_argument("--obs-modes", nargs="+", default=["state", "pointcloud"], help="obs modes to time")
     parser.add_argument("--width", type=int, default=128, help="camera width and height in pixels")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0, help="episode seed")
     parser.add_argument("--capt-every-k", type=int, nargs="*", default=[],
                         help="also time env + CAPT perception (shipped checkpoint), run every K steps")
 

@@ -29,7 +29,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="object category (default: every category with a shipped checkpoint)")
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
     parser.add_argument("--episodes", type=int, default=1, help="episodes per category")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0,
+                        help="first episode seed (episodes use seed, seed+1, ...)")
     parser.add_argument("--out", default="outputs/demo", help="where PNGs and MP4s go")
     parser.add_argument("--no-policy", action="store_true", help="only estimate; do not open the object")
     parser.add_argument("--no-video", action="store_true", help="run the policy without recording MP4s")

@@ -16,12 +16,14 @@ if TYPE_CHECKING:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("checkpoints", nargs="+", help="checkpoints (e.g. CAPT, CAPT-plain, PCT) to compare")
     parser.add_argument("--data", required=True, help="dataset directory made by `capt generate`")
-    parser.add_argument("--split", default="test", choices=["train", "val", "test"])
-    parser.add_argument("--device", default="cpu")
+    parser.add_argument("--split", default="test", choices=["train", "val", "test"],
+                        help="dataset split to score")
+    parser.add_argument("--device", default="cpu", help="torch device (cpu, cuda, cuda:1)")
     parser.add_argument("--timing-clouds", type=int, default=100,
                         help="time at least this many calls per checkpoint (the scored clouds are timed, "
                              "then more calls cycle over the split)")
-    parser.add_argument("--max-samples", type=int, default=None)
+    parser.add_argument("--max-samples", type=int, default=None,
+                        help="score at most this many clouds (default: all)")
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")
     parser.add_argument("--figures", default=None, help="save a cloud+axes PNG per checkpoint here")
     parser.add_argument("--without-double-voting", action="store_true",

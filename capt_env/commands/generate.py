@@ -17,7 +17,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--train", type=int, default=None, help="override the number of train samples")
     parser.add_argument("--val", type=int, default=None, help="override the number of val samples")
     parser.add_argument("--test", type=int, default=None, help="override the number of test samples")
-    parser.add_argument("--seed", type=int, default=None)
+    parser.add_argument("--seed", type=int, default=None, help="override the config's dataset seed")
     parser.add_argument("--workers", type=int, default=None, help="processes (default: every core)")
     add_object_arguments(parser, None, with_categories=False)
 

@@ -38,7 +38,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--noise-model", default="fixed_offset", choices=["fixed_offset", "gaussian"],
                         help="fixed_offset: exactly that error, held for the episode; gaussian: that "
                              "std, redrawn at every estimate")
-    parser.add_argument("--policy", default="scripted", choices=["scripted", "ppo"])
+    parser.add_argument("--policy", default="scripted", choices=["scripted", "ppo"],
+                        help="the policy to evaluate")
     parser.add_argument("--model", default=None,
                         help="PPO model .zip (with --policy ppo; default: the category's shipped policy)")
     parser.add_argument("--opener", default=None,
@@ -46,7 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--episodes", type=int, default=20, help="episodes per category and value")
     parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
     parser.add_argument("--every-k-steps", type=int, default=5, help="perception period in env steps")
-    parser.add_argument("--max-steps", type=int, default=200)
+    parser.add_argument("--max-steps", type=int, default=200, help="control steps per episode (20 Hz)")
     add_noise_argument(parser)
     add_task_argument(parser)
     parser.add_argument("--markdown", default=None, help="also write the table as Markdown here")

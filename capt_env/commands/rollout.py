@@ -21,7 +21,8 @@ if TYPE_CHECKING:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_object_arguments(parser, ["cabinet_door"])
-    parser.add_argument("--policy", default="scripted", choices=["scripted", "ppo"])
+    parser.add_argument("--policy", default="scripted", choices=["scripted", "ppo"],
+                        help="the policy to evaluate")
     parser.add_argument("--model", default=None,
                         help="PPO model .zip (with --policy ppo; default: the category's shipped policy)")
     parser.add_argument("--perception", nargs="+", default=["oracle"],
@@ -30,7 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--episodes", type=int, default=10, help="episodes per category and source")
     parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
     parser.add_argument("--every-k-steps", type=int, default=5, help="perception period in env steps")
-    parser.add_argument("--max-steps", type=int, default=200)
+    parser.add_argument("--max-steps", type=int, default=200, help="control steps per episode (20 Hz)")
     parser.add_argument("--opener", default=None,
                         help="YAML of ScriptedOpenerConfig overrides (with --policy scripted), e.g. "
                              "configs/opener/steep_door_approach.yaml; default: the opener's defaults")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -71,8 +72,7 @@ def test_rollout_opener_overrides_load_and_name_a_bad_key(tmp_path: Path) -> Non
     bad.write_text("approach_gap: 0.2\n")
     with pytest.raises(SystemExit, match="approach_gap"):
         opener_config(str(bad))
-    with pytest.raises(SystemExit, match="--opener"):
-        main(["rollout", "--policy", "ppo", "--opener", str(bad), "--episodes", "1"])
+    assert main(["rollout", "--policy", "ppo", "--opener", str(bad), "--episodes", "1"]) == 2
 
 
 def test_rollout_records_the_opener_it_ran(tmp_path: Path) -> None:
@@ -178,19 +178,22 @@ def test_capt_without_motion_loss_differs_from_capt_in_the_motion_weight_only(tm
     assert (ablation.epochs, ablation.lr, ablation.batch_size) == (capt.epochs, capt.lr, capt.batch_size)
 
 
-def test_evaluate_names_bad_input_without_a_traceback(tmp_path: Path) -> None:
+def test_evaluate_names_bad_input_without_a_traceback(tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
     shipped = str(Path(__file__).resolve().parents[2] / "perception" / "checkpoints" / "oven.pt")
-    with pytest.raises(SystemExit, match="capt evaluate: a checkpoint is given twice"):
-        main(["evaluate", shipped, shipped, "--data", str(tmp_path)])
-    with pytest.raises(SystemExit, match="capt evaluate: .*not found"):
-        main(["evaluate", str(tmp_path / "missing.pt"), "--data", str(tmp_path)])
-    with pytest.raises(SystemExit, match="capt evaluate: no shard_"):
-        main(["evaluate", shipped, "--data", str(tmp_path)])
-    with pytest.raises(SystemExit, match="capt evaluate: jitter_m must be a finite number >= 0"):
-        main(["evaluate", shipped, "--data", str(tmp_path), "--test-jitter", "-0.01"])
-    with pytest.raises(SystemExit, match=r"capt evaluate: outlier_fraction must be in \[0, 1\]"):
-        main(["evaluate", shipped, "--data", str(tmp_path), "--test-outliers", "2"])
-    with pytest.raises(SystemExit, match="capt evaluate: --filter-neighbours and --filter-std-ratio need"):
-        main(["evaluate", shipped, "--data", str(tmp_path), "--filter-std-ratio", "2"])
-    with pytest.raises(SystemExit, match="capt evaluate: neighbours must be an integer >= 1"):
-        main(["evaluate", shipped, "--data", str(tmp_path), "--filter-outliers", "--filter-neighbours", "0"])
+    assert main(["evaluate", shipped, shipped, "--data", str(tmp_path)]) == 2
+    assert re.search("capt evaluate: error: a checkpoint is given twice", capsys.readouterr().err)
+    assert main(["evaluate", str(tmp_path / "missing.pt"), "--data", str(tmp_path)]) == 2
+    assert re.search("capt evaluate: error: .*not found", capsys.readouterr().err)
+    assert main(["evaluate", shipped, "--data", str(tmp_path)]) == 2
+    assert re.search("capt evaluate: error: no shard_", capsys.readouterr().err)
+    assert main(["evaluate", shipped, "--data", str(tmp_path), "--test-jitter", "-0.01"]) == 2
+    assert re.search("capt evaluate: error: jitter_m must be a finite number >= 0", capsys.readouterr().err)
+    assert main(["evaluate", shipped, "--data", str(tmp_path), "--test-outliers", "2"]) == 2
+    assert re.search(r"capt evaluate: error: outlier_fraction must be in \[0, 1\]", capsys.readouterr().err)
+    assert main(["evaluate", shipped, "--data", str(tmp_path), "--filter-std-ratio", "2"]) == 2
+    assert re.search("capt evaluate: error: --filter-neighbours and --filter-std-ratio need",
+                     capsys.readouterr().err)
+    assert main(["evaluate", shipped, "--data", str(tmp_path), "--filter-outliers", "--filter-neighbours",
+                 "0"]) == 2
+    assert re.search("capt evaluate: error: neighbours must be an integer >= 1", capsys.readouterr().err)
