@@ -11,7 +11,9 @@ from capt_env.commands.object_targets import add_object_arguments, object_target
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--config", default=None, help="YAML GenerateConfig (configs/generate/*.yaml)")
+    parser.add_argument("--config", default=None,
+                        help="GenerateConfig: a shipped name (laptop, oven, ...) or a YAML path (default: "
+                             "the GenerateConfig defaults)")
     parser.add_argument("--category", default=None, help="override the config's category")
     parser.add_argument("--out", required=True, help="output directory (resumed if it exists)")
     parser.add_argument("--train", type=int, default=None, help="override the number of train samples")
@@ -27,9 +29,12 @@ def run(args: argparse.Namespace) -> int:
 
     from capt_env.dataset.config import GenerateConfig
     from capt_env.dataset.generator import generate
+    from capt_env.shipped_configs import resolve_config
     from perception.yaml_config import load_yaml
 
-    cfg = load_yaml(GenerateConfig, args.config) if args.config else GenerateConfig()
+    cfg = GenerateConfig()
+    if args.config:
+        cfg = load_yaml(GenerateConfig, resolve_config("generate", args.config))
     counts = dict(cfg.counts)
     for split in ("train", "val", "test"):
         if getattr(args, split) is not None:

@@ -51,13 +51,14 @@ def opener_config(path: str | None) -> ScriptedOpenerConfig:
     """The scripted opener's config: its defaults, overridden by the keys of YAML ``path`` (unknown
     keys and bad values exit with a message naming them)."""
     from agents.scripted.config import ScriptedOpenerConfig
+    from capt_env.shipped_configs import resolve_config
     from perception.yaml_config import ConfigError, load_yaml
 
     if path is None:
         return ScriptedOpenerConfig()
     try:
-        return load_yaml(ScriptedOpenerConfig, path)
-    except ConfigError as err:
+        return load_yaml(ScriptedOpenerConfig, resolve_config("opener", path))
+    except (ConfigError, FileNotFoundError) as err:
         raise SystemExit(f"--opener {path}: {err}") from err
 
 

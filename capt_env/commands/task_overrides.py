@@ -9,8 +9,8 @@ import argparse
 def add_task_argument(parser: argparse.ArgumentParser) -> None:
     """Add ``--task PATH`` to a command's parser."""
     parser.add_argument("--task", default=None,
-                        help="YAML of TaskConfig overrides for every category (cameras, placement, ...), "
-                             "e.g. configs/tasks/two_cameras.yaml; no category/object key (use "
+                        help="TaskConfig overrides for every object (cameras, placement, ...): a shipped "
+                             "name (two_cameras, val_split, ...) or a YAML path; no category/object key (use "
                              "--categories / --object)")
 
 
@@ -20,6 +20,9 @@ def task_overrides(path: str | None) -> dict:
         return {}
     import yaml
 
+    from capt_env.shipped_configs import resolve_config
+
+    path = str(resolve_config("tasks", path))
     with open(path) as fh:
         raw = yaml.safe_load(fh) or {}
     if not isinstance(raw, dict):

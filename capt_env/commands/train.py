@@ -10,7 +10,9 @@ from capt_env.commands.json_output import write_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--config", default="configs/perception/capt.yaml", help="YAML TrainConfig")
+    parser.add_argument("--config", default="capt",
+                        help="TrainConfig: a shipped name (capt, capt_plain, pct_regression, ...) or a YAML "
+                             "path")
     parser.add_argument("--data", required=True, help="dataset directory made by `capt generate`")
     parser.add_argument("--out", required=True, help="run directory: last.pt, best.pt, log.csv")
     parser.add_argument("--epochs", type=int, default=None, help="override the config's epochs")
@@ -38,7 +40,9 @@ def train_config_for(config_path: str, data_dir: str, epochs: int | None, device
     if not manifest.is_file():
         raise SystemExit(f"{data_dir} has no manifest.json: make it with `capt generate`")
     category = json.loads(manifest.read_text())["config"]["category"]
-    cfg = to_dict(load_yaml(TrainConfig, config_path))
+    from capt_env.shipped_configs import resolve_config
+
+    cfg = to_dict(load_yaml(TrainConfig, resolve_config("perception", config_path)))
     cfg["model"]["model"].update(category_structure(category))
     for key, value in {"epochs": epochs, "device": device, "seed": seed}.items():
         if value is not None:

@@ -8,7 +8,8 @@ from capt_env.commands.json_output import write_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--config", default="configs/ppo/laptop.yaml", help="YAML PPOTrainConfig")
+    parser.add_argument("--config", default="laptop",
+                        help="PPOTrainConfig: a shipped name (laptop, drawer_cabinet, ...) or a YAML path")
     parser.add_argument("--out", required=True, help="run directory: checkpoints/, logs/, final.zip")
     parser.add_argument("--total-timesteps", type=int, default=None,
                         help="override the config's total env steps (a resume continues up to it)")
@@ -25,9 +26,10 @@ def _fmt(value: float | None, spec: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from agents.ppo.config import PPOTrainConfig
     from agents.ppo.train import train_ppo
+    from capt_env.shipped_configs import resolve_config
     from perception.yaml_config import ConfigError, from_dict, load_yaml, to_dict
 
-    cfg = to_dict(load_yaml(PPOTrainConfig, args.config))
+    cfg = to_dict(load_yaml(PPOTrainConfig, resolve_config("ppo", args.config)))
     if args.total_timesteps is not None:
         cfg["total_timesteps"] = args.total_timesteps
     if args.device is not None:

@@ -1,0 +1,1 @@
+"""Policies that open articulated objects from joint-axis observations: scripted and PPO."""

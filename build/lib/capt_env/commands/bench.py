@@ -1,0 +1,99 @@
+"""``capt bench``: environment speed on this machine (steps/s per obs mode, reset time)."""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+from tqdm import tqdm
+
+from capt_env.commands.json_output import write_json
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--category", default="laptop", help="object category (default: laptop)")
+    parser.add_argument("--steps", type=int, default=200, help="random-action steps per obs mode")
+    parser.add_argument("--resets", type=int, default=5, help="resets (each builds a new object)")
+    parser.add_argument("--obs-modes", nargs="+", default=["state", "pointcloud"], help="obs modes to time")
+    parser.add_argument("--width", type=int, default=128, help="camera width and height in pixels")
+    parser.add_argument("--seed", type=int, default=0, help="episode seed")
+    parser.add_argument("--capt-every-k", type=int, nargs="*", default=[],
+                        help="also time env + CAPT perception (shipped checkpoint), run every K steps")
+
+
+def measure(category: str, obs_mode: str, steps: int, resets: int, width: int, seed: int) -> dict:
+    """Median reset time (s) and steady-state steps/s of one obs mode; the first reset is reported apart."""
+    import gymnasium as gym
+
+    import capt_env  # noqa: F401
+
+    task = {"cameras": [{"width": width, "height": width}]}
+    t0 = time.perf_counter()
+    env = gym.make(capt_env.env_id(category), obs_mode=obs_mode, task=task)
+    env.reset(seed=seed)
+    first = time.perf_counter() - t0
+    times = []
+    for i in range(resets):
+        t = time.perf_counter()
+        env.reset(seed=seed + 1 + i)
+        times.append(time.perf_counter() - t)
+    env.action_space.seed(seed)
+    for _ in range(5):  # warm-up
+        env.step(env.action_space.sample())
+    t = time.perf_counter()
+    for _ in tqdm(range(steps), desc=f"{obs_mode} steps", leave=False):
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+    elapsed = time.perf_counter() - t
+    env.close()
+    return {
+        "obs_mode": obs_mode,
+        "steps_per_second": steps / elapsed,
+        "ms_per_step": 1000 * elapsed / steps,
+        "reset_seconds_median": statistics.median(times),
+        "first_make_and_reset_seconds": first,
+    }
+
+
+def measure_with_capt(category: str, every_k: int, steps: int, width: int, seed: int) -> dict:
+    """Steps/s of the pointcloud env wrapped with CAPT perception run every ``every_k`` steps."""
+    from agents.scripted.rollout import make_env
+    from perception.checkpoints import default_checkpoint
+
+    wrapper = {"source": "capt", "checkpoint": str(default_checkpoint(category)), "every_k_steps": every_k}
+    env = make_env(category, wrapper, obs_mode="pointcloud",
+                   task={"cameras": [{"width": width, "height": width}]})
+    env.reset(seed=seed)
+    env.action_space.seed(seed)
+    latencies = []
+    t = time.perf_counter()
+    for _ in tqdm(range(steps), desc=f"capt every {every_k}", leave=False):
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+        if info.get("perception_ran"):
+            latencies.append(float(env.last_perception_latency_ms))
+        if terminated or truncated:
+            env.reset()
+    elapsed = time.perf_counter() - t
+    env.close()
+    return {"obs_mode": "pointcloud+capt", "every_k_steps": every_k, "steps_per_second": steps / elapsed,
+            "ms_per_step": 1000 * elapsed / steps,
+            "perception_ms_median": statistics.median(latencies) if latencies else None}
+
+
+def run(args: argparse.Namespace) -> int:
+    results = []
+    for mode in args.obs_modes:
+        r = measure(args.category, mode, args.steps, args.resets, args.width, args.seed)
+        results.append(r)
+        print(f"{args.category:<15} {mode:<11} {r['steps_per_second']:7.1f} steps/s "
+              f"({r['ms_per_step']:.1f} ms/step)  reset {r['reset_seconds_median']:.2f} s "
+              f"(first make+reset {r['first_make_and_reset_seconds']:.1f} s)")
+    for k in args.capt_every_k:
+        r = measure_with_capt(args.category, k, args.steps, args.width, args.seed)
+        results.append(r)
+        print(f"{args.category:<15} pointcloud + CAPT every {k} steps: {r['steps_per_second']:6.1f} steps/s "
+              f"({r['ms_per_step']:.1f} ms/step, perception {r['perception_ms_median']:.1f} ms)")
+    write_json(args.json, {"category": args.category, "camera_pixels": args.width**2, "results": results})
+    return 0

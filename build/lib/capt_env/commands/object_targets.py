@@ -1,0 +1,161 @@
+"""What an evaluation command runs on: procedural categories and user object files.
+
+Every evaluation verb (``rollout``, ``estimate-errors``, ``generate``, ``demo``) takes
+``--categories`` and, beside them, user files: ``--object PATH`` (repeatable; ``--joint``,
+``--front-yaw``, ``--scale`` and ``--like`` apply to each) or ``--objects FILE.yaml`` listing several
+with their own options::
+
+    objects:
+      - path: metaworld/drawer.xml      # relative to the YAML file
+        name: mw_drawer                 # table label (default: the file stem)
+        like: drawer_cabinet            # shipped checkpoint / policy to use (default: by joint type)
+        task: {closed: upper, front_yaw: "-y"}   # TaskConfig keys of the file
+
+Tables name each object by its label.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from capt_env.tasks.config import USER_FILE_KEYS
+
+LIKE_BY_JOINT_TYPE = {0: "cabinet_door", 1: "drawer_cabinet"}
+"""Shipped model used for a user file without ``like``: by its target joint's type (0 revolute)."""
+_ENTRY_KEYS = {"path", "name", "like", "task"}
+_FILE_TASK_KEYS = set(USER_FILE_KEYS) | {"scale", "object_xy", "object_xy_noise", "yaw_noise",
+                                          "target_init_fraction", "other_init_fraction",
+                                          "success_fraction", "cameras"}
+
+
+@dataclass(frozen=True)
+class ObjectTarget:
+    """One thing to evaluate: a procedural ``category``, or a user file given by ``task`` keys
+    (``object`` and its options) with the shipped model ``like`` stands for."""
+
+    label: str
+    category: str | None = None
+    task: dict[str, Any] = field(default_factory=dict)
+    like: str | None = None
+
+    @property
+    def is_file(self) -> bool:
+        return self.category is None
+
+    def model_category(self) -> str:
+        """The category whose shipped checkpoint or policy serves this target."""
+        if self.category is not None:
+            return self.category
+        if self.like is not None:
+            return self.like
+        return LIKE_BY_JOINT_TYPE[target_joint_type(self.task)]
+
+
+def target_joint_type(task: dict[str, Any]) -> int:
+    """Type id (0 revolute, 1 prismatic) of a user file's target joint, by building it once."""
+    from capt_env.objects.scene import create_scene
+    from capt_env.objects.user_files import load_user_object
+
+    scene = create_scene(render=False)
+    _, info = load_user_object(scene, task["object"], joint=task.get("joint"), name="probe",
+                               visual_groups=tuple(task.get("visual_groups", (0, 1, 2))),
+                               mjcf_angle=task.get("mjcf_angle", "auto"))
+    return 1 if info["joint_type"] == "prismatic" else 0
+
+
+def add_object_arguments(parser: argparse.ArgumentParser, categories_default: list[str] | None,
+                         with_categories: bool = True) -> None:
+    """``--categories`` (unless the verb has its own category flag) plus the user-file options."""
+    if with_categories:
+        parser.add_argument("--categories", nargs="*", default=categories_default,
+                            help="procedural object categories (none when only user files are given)")
+    parser.add_argument("--object", action="append", default=[], metavar="PATH",
+                        help="a user URDF/MJCF file (repeatable); evaluated beside --categories")
+    parser.add_argument("--objects", default=None, metavar="FILE.yaml",
+                        help="YAML listing user files with their options (see docs/user_objects.md)")
+    parser.add_argument("--joint", default=None, help="with --object: the joint to open (default: first)")
+    parser.add_argument("--front-yaw", default=None,
+                        help="with --object: azimuth (rad) of the file's front normal, or +x/-x/+y/-y")
+    parser.add_argument("--scale", type=float, default=None, help="with --object: uniform scale")
+    parser.add_argument("--like", default=None,
+                        help="with --object: the category whose shipped model to use (default: by "
+                             "joint type, revolute cabinet_door, prismatic drawer_cabinet)")
+
+
+def _front(value: str | None) -> float | str | None:
+    if value is None:
+        return None
+    try:
+        return float(value)
+    except ValueError:
+        return value
+
+
+def load_objects_yaml(path: str | Path) -> list[ObjectTarget]:
+    """The user files listed in an ``--objects`` YAML (paths relative to it); bad keys are errors
+    naming the file, the entry and the key."""
+    import yaml
+
+    path = Path(path)
+    if not path.is_file():
+        raise SystemExit(f"--objects {path}: file not found")
+    raw = yaml.safe_load(path.read_text()) or {}
+    entries = raw.get("objects") if isinstance(raw, dict) else None
+    if not isinstance(entries, list) or not entries:
+        raise SystemExit(f"--objects {path}: expected a mapping with a non-empty 'objects' list")
+    out = []
+    for k, entry in enumerate(entries):
+        where = f"--objects {path}: objects[{k}]"
+        if not isinstance(entry, dict) or "path" not in entry:
+            raise SystemExit(f"{where}: expected a mapping with a 'path'")
+        unknown = sorted(set(entry) - _ENTRY_KEYS)
+        if unknown:
+            raise SystemExit(f"{where}: unknown keys {unknown}; allowed: {sorted(_ENTRY_KEYS)}")
+        task = dict(entry.get("task") or {})
+        bad = sorted(set(task) - _FILE_TASK_KEYS)
+        if bad:
+            raise SystemExit(
+                f"{where}: task keys {bad} do not apply to a file; allowed: {sorted(_FILE_TASK_KEYS)}")
+        file = Path(entry["path"])
+        file = file if file.is_absolute() else path.parent / file
+        if not file.is_file():
+            raise SystemExit(f"{where}: object file not found: {file}")
+        out.append(ObjectTarget(label=str(entry.get("name") or file.stem), task={"object": str(file), **task},
+                                like=entry.get("like")))
+    return out
+
+
+def object_targets(args: argparse.Namespace) -> list[ObjectTarget]:
+    """The categories and user files of a command's arguments, in that order; at least one."""
+    from capt_env.objects.registry import CATEGORIES
+
+    targets = []
+    for category in args.categories or []:
+        if category not in CATEGORIES:
+            raise SystemExit(f"unknown category {category!r}; known: {list(CATEGORIES)}")
+        targets.append(ObjectTarget(label=category, category=category))
+    per_file = {"joint": args.joint, "front_yaw": _front(args.front_yaw), "scale": args.scale}
+    per_file = {k: v for k, v in per_file.items() if v is not None}
+    if per_file and not args.object:
+        raise SystemExit(f"{sorted(per_file)} apply to --object files; give --object PATH")
+    for path in args.object:
+        if not Path(path).is_file():
+            raise SystemExit(f"--object {path}: file not found")
+        targets.append(ObjectTarget(label=Path(path).stem, task={"object": str(path), **per_file},
+                                    like=args.like))
+    if args.objects:
+        targets.extend(load_objects_yaml(args.objects))
+    if not targets:
+        raise SystemExit("nothing to evaluate: give --categories, --object or --objects")
+    labels = [t.label for t in targets]
+    if len(set(labels)) != len(labels):
+        raise SystemExit(f"two objects share a label in {labels}; name them in --objects")
+    return targets
+
+
+def target_task(target: ObjectTarget, overrides: dict[str, Any]) -> dict[str, Any]:
+    """The task keys of one target: the command's ``--task`` overrides, then the file's own keys."""
+    return {**overrides, **target.task}

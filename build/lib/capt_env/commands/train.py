@@ -1,0 +1,77 @@
+"""``capt train``: train one CAPT variant on a generated dataset (see perception.training)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from capt_env.commands.json_output import write_json
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--config", default="capt",
+                        help="TrainConfig: a shipped name (capt, capt_plain, pct_regression, ...) or a YAML "
+                             "path")
+    parser.add_argument("--data", required=True, help="dataset directory made by `capt generate`")
+    parser.add_argument("--out", required=True, help="run directory: last.pt, best.pt, log.csv")
+    parser.add_argument("--epochs", type=int, default=None, help="override the config's epochs")
+    parser.add_argument("--device", default=None, help="auto, cpu or cuda[:i] (default: the config's)")
+    parser.add_argument("--seed", type=int, default=None,
+                        help="override the config's seed (weights, shuffling, augmentation)")
+    parser.add_argument("--stop-after", type=int, default=None,
+                        help="run at most this many epochs now; run again to resume")
+    parser.add_argument("--no-resume", action="store_true", help="start over even if last.pt exists")
+    parser.add_argument("--init-from", default=None,
+                        help="checkpoint whose weights start a new run (fine-tune, e.g. a shipped one); "
+                             "ignored when resuming from last.pt")
+
+
+def train_config_for(config_path: str, data_dir: str, epochs: int | None, device: str | None,
+                     seed: int | None = None):
+    """The YAML TrainConfig with the model's output channels set for the dataset's category, and the
+    command line's overrides (``None``: keep the config's)."""
+
+    from capt_env.dataset.category_structure import category_structure
+    from perception.config import TrainConfig
+    from perception.yaml_config import from_dict, load_yaml, to_dict
+
+    manifest = Path(data_dir) / "manifest.json"
+    if not manifest.is_file():
+        raise SystemExit(f"{data_dir} has no manifest.json: make it with `capt generate`")
+    category = json.loads(manifest.read_text())["config"]["category"]
+    from capt_env.shipped_configs import resolve_config
+
+    cfg = to_dict(load_yaml(TrainConfig, resolve_config("perception", config_path)))
+    cfg["model"]["model"].update(category_structure(category))
+    for key, value in {"epochs": epochs, "device": device, "seed": seed}.items():
+        if value is not None:
+            cfg[key] = value
+    return from_dict(TrainConfig, cfg), category
+
+
+def run(args: argparse.Namespace) -> int:
+    from perception.training import train
+
+    cfg, category = train_config_for(args.config, args.data, args.epochs, args.device, args.seed)
+    result = train(cfg, args.data, args.out, resume=not args.no_resume, stop_after=args.stop_after,
+                   init_from=args.init_from)
+    print(f"{category} {cfg.model.model.variant}: {result.epochs_run}/{cfg.epochs} epochs, "
+          f"best val loss {result.best_val_loss:.4f}, voting window {result.voting_window}, "
+          f"best checkpoint {result.best_path}")
+    write_json(args.json, {
+        "category": category, "variant": cfg.model.model.variant, "epochs_run": result.epochs_run,
+        "epochs": cfg.epochs, "seed": cfg.seed, "best_val_loss": result.best_val_loss,
+        "voting_window": list(result.voting_window), "best_path": str(result.best_path),
+        "log": str(result.log_path), "init_from": args.init_from,
+        "epoch_seconds": epoch_seconds(result.log_path),
+    })
+    return 0
+
+
+def epoch_seconds(log_path: str | Path) -> list[float]:
+    """Wall seconds of each epoch in a run's ``log.csv`` (resumed epochs included), in epoch order."""
+    import csv
+
+    with open(log_path, newline="") as fh:
+        return [float(row["seconds"]) for row in csv.DictReader(fh)]

@@ -1,0 +1,121 @@
+"""Drawer cabinet: an open-front carcass with 1..3 stacked drawers on prismatic joints.
+
+Zero/sign rule: state 0 = drawer closed (front flush with the carcass); each axis is -x (the
+front normal, towards the robot), so a positive state pulls the drawer out; limits
+[0, 0.7..0.85 x drawer depth] m. Each drawer front carries a horizontal bar or a knob; the target
+drawer is drawn per instance and its handle centre is the grasp point. Drawers are named
+``drawer_0`` (bottom) upwards, joints ``drawer_0_slide`` and so on.
+Object frame: front faces -x, resting on z = 0.
+"""
+
+from __future__ import annotations
+
+from capt_env.objects.parts import (
+    BODY_WHITES,
+    METALS,
+    WOODS,
+    bar_handle,
+    box_from_bounds,
+    knob_handle,
+    open_carcass,
+)
+from capt_env.objects.sampling import ParamSampler
+from capt_env.objects.spec import JointSpec, LinkSpec, ObjectSpec
+
+CATEGORY = "drawer_cabinet"
+GAP = 0.002  # m, between drawer fronts and around them
+
+
+def make(instance_id: int) -> ObjectSpec:
+    """The drawer-cabinet instance ``instance_id`` (metres)."""
+    s = ParamSampler(CATEGORY, instance_id)
+    count = s.integer("num_drawers", 1, 3)
+    width = s.uniform("width", 0.30, 0.50)
+    depth = s.uniform("depth", 0.28, 0.45)
+    slot = s.uniform("drawer_height", 0.10, 0.17)
+    wall = s.uniform("wall", 0.012, 0.022)
+    front_t = s.uniform("front_thickness", 0.012, 0.022)
+    side_t = s.uniform("drawer_wall", 0.006, 0.012)
+    box_frac = s.uniform("drawer_box_height_frac", 0.6, 0.8)
+    depth_frac = s.uniform("drawer_depth_frac", 0.85, 0.95)
+    travel = s.uniform("travel_frac", 0.7, 0.85)
+    handle_style = s.choice("handle_style", ("bar", "knob"))
+    handle_t = s.uniform("handle_thickness", 0.012, 0.02)
+    standoff = s.uniform("handle_standoff", 0.03, 0.045)
+    handle_len = s.uniform("handle_length_frac", 0.3, 0.6)
+    target = s.integer("target_drawer", 0, count - 1)
+    body_color = s.color("body_color", WOODS + BODY_WHITES)
+    front_color = s.color("front_color", WOODS + BODY_WHITES)
+    inner_color = s.color("inner_color", WOODS)
+    handle_color = s.color("handle_color", METALS)
+
+    height = count * slot + 2 * wall
+    xf = -depth / 2
+    body = LinkSpec("body", tuple(open_carcass(width, depth, height, wall, body_color)), density=400.0)
+    links, joints, grasp = [body], [], (0.0, 0.0, 0.0)
+    y0, y1 = -width / 2 + wall + GAP, width / 2 - wall - GAP
+    inner_depth = depth_frac * (depth - wall - front_t)
+    for i in range(count):
+        z0 = wall + i * slot + GAP
+        z1 = wall + (i + 1) * slot - GAP
+        xb = xf + front_t + inner_depth  # back of the drawer box
+        zt = z0 + box_frac * (z1 - z0)
+        boxes = [
+            box_from_bounds((xf, y0, z0), (xf + front_t, y1, z1), front_color),  # front
+            box_from_bounds((xf + front_t, y0 + GAP, z0), (xb, y1 - GAP, z0 + side_t), inner_color),  # bottom
+            box_from_bounds((xf + front_t, y0 + GAP, z0 + side_t), (xb, y0 + GAP + side_t, zt), inner_color),
+            box_from_bounds((xf + front_t, y1 - GAP - side_t, z0 + side_t), (xb, y1 - GAP, zt), inner_color),
+            box_from_bounds(
+                (xb - side_t, y0 + GAP + side_t, z0 + side_t), (xb, y1 - GAP - side_t, zt), inner_color
+            ),
+        ]
+        zc = (z0 + z1) / 2
+        if handle_style == "bar":
+            handle, centre = bar_handle(
+                (xf, 0.0, zc),
+                normal=0,
+                normal_sign=-1.0,
+                along=1,
+                length=handle_len * (y1 - y0),
+                thickness=handle_t,
+                standoff=standoff,
+                color=handle_color,
+            )
+        else:
+            handle, centre = knob_handle(
+                (xf, 0.0, zc),
+                normal=0,
+                normal_sign=-1.0,
+                cap_size=0.028,
+                cap_depth=0.02,
+                standoff=standoff - 0.01,
+                color=handle_color,
+            )
+        boxes += handle
+        name = f"drawer_{i}"
+        links.append(LinkSpec(name, tuple(boxes), density=300.0))
+        joints.append(
+            JointSpec(
+                f"{name}_slide",
+                "prismatic",
+                "body",
+                name,
+                (xf, 0.0, zc),
+                (-1.0, 0.0, 0.0),
+                (0.0, travel * inner_depth),
+                damping=5.0,
+                friction=0.05,
+            )
+        )
+        if i == target:
+            grasp = centre
+    return ObjectSpec(
+        CATEGORY,
+        instance_id,
+        tuple(links),
+        tuple(joints),
+        target_joint=f"drawer_{target}_slide",
+        grasp_link=f"drawer_{target}",
+        grasp_point=grasp,
+        params=s.params,
+    )

@@ -1,0 +1,347 @@
+"""ManiSkill3 task: a Panda arm on a table opens one articulated object seen by depth cameras.
+
+**Task.** A Panda (control mode ``pd_ee_delta_pose`` by default; any Panda mode can be passed)
+stands at the table edge; an articulated object (a procedural category instance, or a user URDF/MJCF
+file) stands on the table with its front to the robot. The robot must open the target joint: swing
+the door/lid about its hinge, or pull the drawer.
+
+**Randomisations** (per episode, from the episode seed; see :class:`TaskConfig`):
+- the object instance (drawn from the configured split or id list; a new one each reconfiguration,
+  which by default happens every reset when ``num_envs == 1``);
+- the object's position on the table (+-``object_xy_noise``) and yaw (+-``yaw_noise``);
+- the target joint's initial state (fraction ``target_init_fraction`` of its range) and the other
+  joints' states (``other_init_fraction``);
+- each camera's eye position (+-``jitter`` metres per axis), always looking at the object;
+- the robot's initial joint positions (Gaussian noise ``robot_init_qpos_noise`` rad).
+
+**Joint states.** Every joint's state is 0 closed and grows while opening, in radians or metres:
+for a file whose part is closed at its upper limit the simulator position is turned around
+(``LoadedObject.sim_qpos`` / ``task_state``), and so is the reported axis.
+
+**Success.** The target joint is past ``success_fraction`` (default 0.75) of its range, measured from
+the closed state, and its child link is at rest.
+
+**Reward.** Dense: ``reach + 2 * progress + 2 * success`` where ``reach = 1 - tanh(5 d)`` with
+``d`` the gripper-to-grasp-point distance in metres (held at 1 once the part has moved),
+``progress = clip(open_fraction / success_fraction, 0, 1)``. Normalised dense: the same / 5.
+
+**Ground truth.** ``info`` holds, for every movable joint of the object (batched, world frame):
+``joint_type`` (0 revolute, 1 prismatic), ``joint_axis`` (unit, +state opens), ``joint_pivot``
+(a point on the axis: the joint frame origin), ``joint_state`` (rad or m), ``joint_limits``,
+``joint_child_part``, plus ``target_joint``, ``open_fraction``, ``grasp_point``, ``success``.
+In ``pointcloud`` mode the observation's ``pointcloud`` dict also carries ``part_label``: for each
+point the object part it lies on (0 = everything fixed to the base, ``k + 1`` = the part movable
+joint ``k`` moves, links joined by fixed joints counted as one part), or -1 for anything that is not
+the object.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import sapien
+import torch
+from gymnasium.utils import seeding as gym_seeding
+from mani_skill.agents.robots import Panda
+from mani_skill.envs.sapien_env import BaseEnv
+from mani_skill.sensors.camera import CameraConfig as MSCameraConfig
+from mani_skill.utils import sapien_utils
+from mani_skill.utils.scene_builder.table import TableSceneBuilder
+from mani_skill.utils.structs import Articulation, Pose
+
+from capt_env.rendering import translate_render_error
+from capt_env.tasks.config import TaskConfig
+from capt_env.tasks.object_loading import LoadedObject, load_object
+from perception.yaml_config import from_dict
+
+JOINT_TYPE_IDS = {"revolute": 0, "prismatic": 1}
+# End-effector deltas: [-1, 1] maps to +-0.1 m / +-0.1 rad per 20 Hz control step (ManiSkill 3.0.1
+# applies the rotation part with a negative scale: a +1 rotation action turns by -0.1 rad).
+DEFAULT_CONTROL_MODE = "pd_ee_delta_pose"
+ROBOT_BASE_XY = (-0.615, 0.0)
+
+
+@dataclass(frozen=True)
+class _Placement:
+    """Where the object's root goes and what the cameras look at, world frame (per env)."""
+
+    root_p: torch.Tensor  # (b, 3) metres
+    root_q: torch.Tensor  # (b, 4) wxyz
+    centre: torch.Tensor  # (b, 3) object bounding-box centre, metres
+
+
+def _yaw_quat(yaw: torch.Tensor) -> torch.Tensor:
+    """(b,) yaw in radians -> (b, 4) wxyz quaternions about world +z."""
+    half = yaw / 2
+    zeros = torch.zeros_like(half)
+    return torch.stack([torch.cos(half), zeros, zeros, torch.sin(half)], dim=-1)
+
+
+class OpenArticulatedEnv(BaseEnv):
+    """Open an articulated object with a Panda. See the module docstring for the full description."""
+
+    SUPPORTED_ROBOTS = ["panda"]
+    SUPPORTED_OBS_MODES = ("none", "state", "state_dict", "pointcloud", "sensor_data", "rgb", "depth",
+                           "rgbd", "rgb+depth", "rgb+depth+segmentation", "rgb+segmentation",
+                           "depth+segmentation", "segmentation")
+    agent: Panda
+
+    def __init__(
+        self,
+        *args: Any,
+        robot_uids: str = "panda",
+        robot_init_qpos_noise: float = 0.02,
+        task: TaskConfig | dict | None = None,
+        reconfiguration_freq: int | None = None,
+        num_envs: int = 1,
+        **kwargs: Any,
+    ) -> None:
+        overrides = {k: kwargs.pop(k) for k in list(kwargs) if k in _TASK_FIELDS}
+        where = "task"
+        if isinstance(task, (str, Path)):  # a YAML file of TaskConfig keys
+            where = str(task)
+            task = _read_task_yaml(Path(task))
+        if isinstance(task, TaskConfig):
+            base = dataclasses.asdict(task)
+            base["cameras"] = list(task.cameras)
+        else:
+            base = dict(task or {})
+        for key, value in overrides.items():  # the id's own keys (a category id's category)
+            if value is None:
+                continue
+            if key in base and base[key] is not None and base[key] != value:
+                raise ValueError(f"{where}: {key}={base[key]!r} conflicts with this env id's "
+                                 f"{key}={value!r}; use {GENERIC_NAME} for any {key}")
+            if key == "category" and base.get("object") is not None:
+                raise ValueError(f"{where}: object={base['object']!r} on a category id; use {GENERIC_NAME} "
+                                 "for user files")
+            base[key] = value
+        self.task_config: TaskConfig = from_dict(TaskConfig, base, where=where)
+        self.robot_init_qpos_noise = robot_init_qpos_noise
+        self.object: LoadedObject | None = None
+        if reconfiguration_freq is None:
+            reconfiguration_freq = 1 if num_envs == 1 else 0
+        kwargs.setdefault("control_mode", DEFAULT_CONTROL_MODE)
+        if "render_backend" not in kwargs and not torch.cuda.is_available():
+            kwargs["render_backend"] = "cpu"  # ManiSkill asks for CUDA first and warns on every env
+        self._entropy_seed_pending = False
+        with translate_render_error():
+            super().__init__(
+                *args,
+                robot_uids=robot_uids,
+                reconfiguration_freq=reconfiguration_freq,
+                num_envs=num_envs,
+                **kwargs,
+            )
+        self._entropy_seed_pending = True  # the constructor's own reset used ManiSkill's fixed seed
+
+    def reset(self, seed: int | list[int] | None = None, options: dict | None = None) -> tuple[Any, dict]:
+        if seed is None and self._entropy_seed_pending:
+            # Gymnasium's rule: the first unseeded reset draws fresh entropy, so processes differ
+            seed = int(np.random.SeedSequence().entropy % (2**31))
+        self._entropy_seed_pending = False
+        if seed is not None:
+            # Gymnasium's own generator (env.np_random), seeded like ManiSkill's episode RNGs.
+            first = int(seed[0]) if isinstance(seed, (list, tuple, np.ndarray)) else int(seed)
+            self._np_random, self._np_random_seed = gym_seeding.np_random(first)
+        return super().reset(seed=seed, options=options)
+
+    # ------------------------------------------------------------------ scene
+    @property
+    def _default_sensor_configs(self) -> list[MSCameraConfig]:
+        x, y = self.task_config.placement_xy()
+        target = np.array([x, y, 0.15])
+        configs = []
+        for cam in self.task_config.cameras:
+            eye = target + np.asarray(cam.eye)
+            pose = sapien_utils.look_at(eye=eye.tolist(), target=target.tolist())
+            configs.append(
+                MSCameraConfig(cam.name, pose=pose, width=cam.width, height=cam.height, fov=cam.fov,
+                               near=cam.near, far=cam.far)
+            )
+        return configs
+
+    @property
+    def _default_human_render_camera_configs(self) -> MSCameraConfig:
+        pose = sapien_utils.look_at(eye=[-0.9, -0.9, 0.9], target=[0.1, 0.0, 0.15])
+        return MSCameraConfig("render_camera", pose=pose, width=512, height=512, fov=1.0, near=0.01,
+                              far=100)
+
+    def _load_agent(self, options: dict) -> None:
+        super()._load_agent(options, sapien.Pose(p=[*ROBOT_BASE_XY, 0.0]))
+
+    def _load_scene(self, options: dict) -> None:
+        self.table_scene = TableSceneBuilder(self, robot_init_qpos_noise=self.robot_init_qpos_noise)
+        self.table_scene.build()
+        instance_id = options.get("instance_id") if options else None
+        self.object = load_object(self.scene, self.task_config, self._episode_rng, instance_id)
+
+    @property
+    def articulation(self) -> Articulation:
+        """The object being opened (ManiSkill articulation, batched over sub-scenes)."""
+        assert self.object is not None
+        return self.object.articulation
+
+    # ---------------------------------------------------------------- episode
+    def _initialize_episode(self, env_idx: torch.Tensor, options: dict) -> None:
+        cfg = self.task_config
+        obj = self.object
+        b = len(env_idx)
+        with torch.device(self.device):
+            self.table_scene.initialize(env_idx)
+            rng = self._batched_episode_rng[env_idx]
+            noise_xy = np.stack([rng.uniform(-n, n) for n in cfg.object_xy_noise], axis=-1)
+            yaw = obj.front_yaw + rng.uniform(-cfg.yaw_noise, cfg.yaw_noise)
+            placement = self._placement(torch.as_tensor(noise_xy, dtype=torch.float32),
+                                        torch.as_tensor(yaw, dtype=torch.float32))
+            self.articulation.set_pose(Pose.create_from_pq(p=placement.root_p, q=placement.root_q))
+
+            span = obj.limits[:, 1] - obj.limits[:, 0]
+            frac = np.stack([rng.uniform(*cfg.other_init_fraction) for _ in range(obj.dof)], axis=-1)
+            frac[:, obj.target_joint] = rng.uniform(*cfg.target_init_fraction)
+            qpos = obj.sim_qpos(frac.reshape(b, obj.dof) * span)
+            self.articulation.set_qpos(torch.as_tensor(qpos, dtype=torch.float32))
+            self.articulation.set_qvel(torch.zeros((b, obj.dof)))
+            self._aim_cameras(placement, float(np.asarray(yaw).reshape(-1)[0]), self._episode_rng)
+
+    def _placement(self, noise_xy: torch.Tensor, yaw: torch.Tensor) -> _Placement:
+        """Root pose putting the object's bounding-box centre at ``placement_xy() + noise`` on the table."""
+        obj = self.object
+        lo, hi = obj.aabb
+        centre_local = torch.as_tensor((lo + hi) / 2, dtype=torch.float32)
+        target_xy = torch.as_tensor(self.task_config.placement_xy(), dtype=torch.float32) + noise_xy
+        c, s = torch.cos(yaw), torch.sin(yaw)
+        rot_cx = c * centre_local[0] - s * centre_local[1]
+        rot_cy = s * centre_local[0] + c * centre_local[1]
+        z = torch.full_like(yaw, float(-lo[2]) + 1e-3)
+        root_p = torch.stack([target_xy[:, 0] - rot_cx, target_xy[:, 1] - rot_cy, z], dim=-1)
+        centre = torch.stack([target_xy[:, 0], target_xy[:, 1], z + float(centre_local[2])], dim=-1)
+        return _Placement(root_p=root_p, root_q=_yaw_quat(yaw), centre=centre)
+
+    def _aim_cameras(self, placement: _Placement, yaw: float, rng: Any) -> None:
+        """Point every camera at the object's centre (env 0's pose is used for all sub-scenes).
+
+        ``yaw`` is env 0's object yaw; the object's front then faces world direction ``yaw - front_yaw``
+        rotated from +x, i.e. towards the robot (-x) up to the yaw noise.
+        """
+        target = placement.centre[0].cpu().numpy().astype(np.float64)
+        front = yaw - self.object.front_yaw + np.pi  # world azimuth of the object's front normal
+        for cam in self.task_config.cameras:
+            if cam.name not in self._sensors:
+                continue
+            if cam.random_view:
+                dist = float(rng.uniform(*cam.distance))
+                az = front + float(rng.uniform(*cam.azimuth))
+                el = float(rng.uniform(*cam.elevation))
+                offset = dist * np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+            else:
+                offset = np.asarray(cam.eye, dtype=np.float64)
+                offset = offset + np.asarray(rng.uniform(-cam.jitter, cam.jitter, size=3)).reshape(3)
+            pose = sapien_utils.look_at(eye=(target + offset).tolist(), target=target.tolist())
+            self._sensors[cam.name].camera.set_local_pose(pose.sp)
+
+    # ------------------------------------------------------------ evaluation
+    def joint_ground_truth(self) -> dict[str, torch.Tensor]:
+        """World-frame ground truth of every movable joint, batched: see the module docstring."""
+        obj = self.object
+        axes, pivots = [], []
+        for joint, sign in zip(obj.joints, obj.open_sign, strict=True):
+            mat = joint.get_global_pose().to_transformation_matrix()  # (b, 4, 4)
+            axes.append(float(sign) * mat[..., :3, 0])  # turned so that a growing state opens
+            pivots.append(mat[..., :3, 3])
+        b = self.num_envs
+        return {
+            "joint_type": torch.as_tensor(obj.joint_type_ids, device=self.device).expand(b, -1),
+            "joint_axis": torch.stack(axes, dim=1),
+            "joint_pivot": torch.stack(pivots, dim=1),
+            "joint_state": obj.task_state(self.articulation.qpos),
+            "joint_limits": torch.as_tensor(obj.limits, dtype=torch.float32, device=self.device)
+            .expand(b, -1, -1),
+            "joint_child_part": torch.as_tensor(obj.child_parts, device=self.device).expand(b, -1),
+        }
+
+    def grasp_point(self) -> torch.Tensor:
+        """(b, 3) world-frame grasp point on the target part (handle centre or far edge), metres."""
+        obj = self.object
+        mat = obj.grasp_link.pose.to_transformation_matrix()
+        local = torch.as_tensor(obj.grasp_local, dtype=torch.float32, device=self.device)
+        return (mat[..., :3, :3] @ local) + mat[..., :3, 3]
+
+    def evaluate(self) -> dict[str, torch.Tensor]:
+        cfg = self.task_config
+        obj = self.object
+        gt = self.joint_ground_truth()
+        k = obj.target_joint
+        lo, hi = float(obj.limits[k, 0]), float(obj.limits[k, 1])
+        open_fraction = (gt["joint_state"][:, k] - lo) / (hi - lo)
+        child = obj.target_child_link
+        at_rest = (torch.linalg.norm(child.linear_velocity, dim=-1) <= cfg.rest_linear_speed) & (
+            torch.linalg.norm(child.angular_velocity, dim=-1) <= cfg.rest_angular_speed
+        )
+        opened = open_fraction >= cfg.success_fraction
+        return {
+            **gt,
+            "target_joint": torch.full((self.num_envs,), k, device=self.device, dtype=torch.long),
+            "open_fraction": open_fraction,
+            "grasp_point": self.grasp_point(),
+            "opened": opened,
+            "success": opened & at_rest,
+        }
+
+    def _get_obs_extra(self, info: dict) -> dict[str, torch.Tensor]:
+        obs = {"tcp_pose": self.agent.tcp.pose.raw_pose}
+        if "state" in self.obs_mode:
+            obs.update(
+                grasp_point=info["grasp_point"],
+                tcp_to_grasp=info["grasp_point"] - self.agent.tcp.pose.p,
+                target_qpos=self.object.task_state(self.articulation.qpos)[:, [self.object.target_joint]],
+                open_fraction=info["open_fraction"].unsqueeze(-1),
+            )
+        return obs
+
+    def get_obs(self, info: dict | None = None, unflattened: bool = False) -> Any:
+        obs = super().get_obs(info, unflattened)
+        if self.obs_mode == "pointcloud" and isinstance(obs, dict) and "pointcloud" in obs:
+            seg = obs["pointcloud"]["segmentation"][..., 0].long()
+            obs["pointcloud"]["part_label"] = self.part_labels_from_segmentation(seg)
+        if isinstance(obs, dict):
+            # ManiSkill leaves an empty "sensor_data" dict in pointcloud mode; Gymnasium forbids empty Dicts.
+            obs = {k: v for k, v in obs.items() if not (isinstance(v, dict) and len(v) == 0)}
+        return obs
+
+    def part_labels_from_segmentation(self, seg: torch.Tensor) -> torch.Tensor:
+        """Map simulator per-scene segmentation ids (b, N) to object part labels (b, N); -1 = not object."""
+        lut = self.object.segmentation_lut.to(seg.device)
+        clipped = seg.clamp(0, lut.shape[-1] - 1)
+        labels = torch.gather(lut.expand(seg.shape[0], -1), 1, clipped)
+        return torch.where(seg < lut.shape[-1], labels, torch.full_like(labels, -1))
+
+    def compute_dense_reward(self, obs: Any, action: torch.Tensor, info: dict) -> torch.Tensor:
+        dist = torch.linalg.norm(self.agent.tcp.pose.p - info["grasp_point"], dim=-1)
+        reach = 1 - torch.tanh(5 * dist)
+        progress = (info["open_fraction"] / self.task_config.success_fraction).clamp(0, 1)
+        reach = torch.where(progress > 0.02, torch.ones_like(reach), reach)
+        return reach + 2 * progress + 2 * info["success"].float()
+
+    def compute_normalized_dense_reward(self, obs: Any, action: torch.Tensor, info: dict) -> torch.Tensor:
+        return self.compute_dense_reward(obs=obs, action=action, info=info) / 5.0
+
+
+_TASK_FIELDS = {f.name for f in dataclasses.fields(TaskConfig)}
+GENERIC_NAME = "CaptOpenArticulated-v0"
+
+
+def _read_task_yaml(path: Path) -> dict:
+    """TaskConfig keys from a YAML file (validated with the file named in errors)."""
+    import yaml
+
+    if not path.is_file():
+        raise FileNotFoundError(f"task file not found: {path}")
+    raw = yaml.safe_load(path.read_text()) or {}
+    if not isinstance(raw, dict):
+        raise ValueError(f"{path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
+    return raw
