@@ -129,6 +129,8 @@ class OpenArticulatedEnv(BaseEnv):
         if "render_backend" not in kwargs and not torch.cuda.is_available():
             kwargs["render_backend"] = "cpu"  # ManiSkill asks for CUDA first and warns on every env
         self._entropy_seed_pending = False
+        self.sensors_on_next_obs = True  # see get_obs
+        self._held_obs: dict[bool | None, Any] = {}
         with translate_render_error():
             super().__init__(
                 *args,
@@ -304,6 +306,23 @@ class OpenArticulatedEnv(BaseEnv):
         return obs
 
     def get_obs(self, info: dict | None = None, unflattened: bool = False) -> Any:
+        """ManiSkill's observation, plus ``part_label`` in pointcloud mode. With
+        ``sensors_on_next_obs`` set False by a caller that will not look at the cameras on the next
+        step (the perception wrapper between its looks), that step returns the last rendered
+        observation again instead of rendering: rendering does not change the simulation, so the
+        episode is the same, only the unused cloud is stale. The flag resets to True each time."""
+        renders = self._obs_mode not in ("none", "state", "state_dict")
+        # flattening changes a sensor observation only when it carries a state vector
+        key = unflattened if self.obs_mode_struct.state else None
+        skip, self.sensors_on_next_obs = not self.sensors_on_next_obs, True
+        if skip and renders and key in self._held_obs:
+            return self._held_obs[key]
+        obs = self._rendered_obs(info, unflattened)
+        if renders:
+            self._held_obs = {key: obs}
+        return obs
+
+    def _rendered_obs(self, info: dict | None, unflattened: bool) -> Any:
         obs = super().get_obs(info, unflattened)
         if self.obs_mode == "pointcloud" and isinstance(obs, dict) and "pointcloud" in obs:
             seg = obs["pointcloud"]["segmentation"][..., 0].long()

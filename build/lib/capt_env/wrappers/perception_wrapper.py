@@ -10,7 +10,9 @@ isolated object points of the last run; -1 when the source reads no cloud). The 
 the last run (isolation + estimate, ms) is the attribute ``last_perception_latency_ms``, not an
 ``info`` entry, so that a step's info depends only on the seed and the actions (Gymnasium's
 determinism check).
-Oracle sources work with any obs mode; ``capt`` needs ``obs_mode="pointcloud"``.
+Oracle sources work with any obs mode; ``capt`` needs ``obs_mode="pointcloud"``. The cameras render
+only on the steps perception looks at them (never for oracle sources): the base env repeats its
+last observation in between, which changes nothing the wrapper returns.
 """
 
 from __future__ import annotations
@@ -87,9 +89,12 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         return self._observation(), self._info(info, True, latency)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict]:
+        ran = (self._steps + 1) % self.config.every_k_steps == 0
+        base = self.env.unwrapped
+        if hasattr(base, "sensors_on_next_obs"):  # render only when the cameras are looked at
+            base.sensors_on_next_obs = ran and self.source.needs_points
         obs, reward, terminated, truncated, info = self.env.step(action)
         self._steps += 1
-        ran = self._steps % self.config.every_k_steps == 0
         latency = self._perceive(obs, info) if ran else 0.0
         out_info = self._info(info, ran, latency)
         return self._observation(), float(reward), bool(terminated), bool(truncated), out_info
