@@ -57,14 +57,20 @@ def measure(category: str, obs_mode: str, steps: int, resets: int, width: int, s
     }
 
 
-def measure_with_capt(category: str, every_k: int, steps: int, width: int, seed: int) -> dict:
-    """Steps/s of the pointcloud env wrapped with CAPT perception run every ``every_k`` steps."""
+def measure_with_capt(category: str, every_k: int, steps: int, width: int, seed: int,
+                      render_every_step: bool = False) -> dict:
+    """Steps/s of the pointcloud env wrapped with CAPT perception run every ``every_k`` steps. The
+    wrapper renders only on perception steps; ``render_every_step`` times the path it replaced (the
+    cameras rendered on every step), for an A/B in one run."""
     from agents.scripted.rollout import make_env
     from perception.checkpoints import default_checkpoint
 
     wrapper = {"source": "capt", "checkpoint": str(default_checkpoint(category)), "every_k_steps": every_k}
     env = make_env(category, wrapper, obs_mode="pointcloud",
                    task={"cameras": [{"width": width, "height": width}]})
+    if render_every_step:
+        base = env.unwrapped
+        base.get_obs = lambda info=None, unflattened=False: base._rendered_obs(info, unflattened)
     env.reset(seed=seed)
     env.action_space.seed(seed)
     latencies = []
@@ -77,7 +83,8 @@ def measure_with_capt(category: str, every_k: int, steps: int, width: int, seed:
             env.reset()
     elapsed = time.perf_counter() - t
     env.close()
-    return {"obs_mode": "pointcloud+capt", "every_k_steps": every_k, "steps_per_second": steps / elapsed,
+    return {"obs_mode": "pointcloud+capt", "every_k_steps": every_k, "render_every_step": render_every_step,
+            "steps_per_second": steps / elapsed,
             "ms_per_step": 1000 * elapsed / steps,
             "perception_ms_median": statistics.median(latencies) if latencies else None}
 
@@ -90,10 +97,17 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.category:<15} {mode:<11} {r['steps_per_second']:7.1f} steps/s "
               f"({r['ms_per_step']:.1f} ms/step)  reset {r['reset_seconds_median']:.2f} s "
               f"(first make+reset {r['first_make_and_reset_seconds']:.1f} s)")
+    state = next((r["steps_per_second"] for r in results if r["obs_mode"] == "state"), None)
     for k in args.capt_every_k:
-        r = measure_with_capt(args.category, k, args.steps, args.width, args.seed)
-        results.append(r)
-        print(f"{args.category:<15} pointcloud + CAPT every {k} steps: {r['steps_per_second']:6.1f} steps/s "
-              f"({r['ms_per_step']:.1f} ms/step, perception {r['perception_ms_median']:.1f} ms)")
+        for every_step in (True, False):  # the old path (render every step), then the wrapper's
+            r = measure_with_capt(args.category, k, args.steps, args.width, args.seed, every_step)
+            if state:
+                r["ratio_to_state"] = r["steps_per_second"] / state
+            results.append(r)
+            path = "rendering every step" if every_step else "rendering on perception steps"
+            ratio = f", {r['ratio_to_state']:.2f} x state" if state else ""
+            print(f"{args.category:<15} pointcloud + CAPT every {k} steps, {path}: "
+                  f"{r['steps_per_second']:6.1f} steps/s ({r['ms_per_step']:.1f} ms/step, "
+                  f"perception {r['perception_ms_median']:.1f} ms{ratio})")
     write_json(args.json, {"category": args.category, "camera_pixels": args.width**2, "results": results})
     return 0
