@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import site
 import subprocess
 import sys
@@ -17,8 +18,11 @@ REPO = Path(__file__).resolve().parents[2]
 def installed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A fresh venv holding only the built wheel; the test venv's dependencies are visible to it."""
     root = tmp_path_factory.mktemp("wheel")
+    source = root / "source"  # a copy, so that the build leaves nothing in the checkout
+    shutil.copytree(REPO, source, symlinks=True, ignore=shutil.ignore_patterns(
+        ".venv", "data", "runs", "outputs", "build", "*.egg-info", ".git", "__pycache__", ".pytest_cache"))
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w",
-                    str(root / "dist"), str(REPO)], check=True, timeout=600)
+                    str(root / "dist"), str(source)], check=True, timeout=600)
     (wheel,) = (root / "dist").glob("capt_env-*.whl")
     venv = root / "venv"
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True, timeout=120)

@@ -1,1 +1,0 @@
-"""Policies that open articulated objects from joint-axis observations: scripted and PPO."""
