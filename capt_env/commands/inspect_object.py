@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
     import torch
 
     import capt_env
-    from capt_env.commands.object_targets import _front
+    from capt_env.commands.object_targets import parse_front_yaw
     from capt_env.commands.task_overrides import task_overrides
 
     path = Path(args.path)
@@ -102,7 +102,8 @@ def run(args: argparse.Namespace) -> int:
     task: dict[str, Any] = {**task_overrides(args.task), "object": str(path), "yaw_noise": 0.0,
                             "object_xy_noise": [0.0, 0.0], "target_init_fraction": [0.0, 0.0],
                             "other_init_fraction": [0.0, 0.0]}
-    for key, value in (("joint", args.joint), ("front_yaw", _front(args.front_yaw)), ("scale", args.scale)):
+    given = {"joint": args.joint, "front_yaw": parse_front_yaw(args.front_yaw), "scale": args.scale}
+    for key, value in given.items():
         if value is not None:
             task[key] = value
     task.setdefault("cameras", [{"width": 320, "height": 320}])

@@ -85,7 +85,8 @@ def add_object_arguments(parser: argparse.ArgumentParser, categories_default: li
                              "joint type, revolute cabinet_door, prismatic drawer_cabinet)")
 
 
-def _front(value: str | None) -> float | str | None:
+def parse_front_yaw(value: str | None) -> float | str | None:
+    """A ``--front-yaw`` argument: radians as a float, or a named axis (``"-x"``) as it is."""
     if value is None:
         return None
     try:
@@ -137,7 +138,7 @@ def object_targets(args: argparse.Namespace) -> list[ObjectTarget]:
         if category not in CATEGORIES:
             raise SystemExit(f"unknown category {category!r}; known: {list(CATEGORIES)}")
         targets.append(ObjectTarget(label=category, category=category))
-    per_file = {"joint": args.joint, "front_yaw": _front(args.front_yaw), "scale": args.scale}
+    per_file = {"joint": args.joint, "front_yaw": parse_front_yaw(args.front_yaw), "scale": args.scale}
     per_file = {k: v for k, v in per_file.items() if v is not None}
     if per_file and not args.object:
         raise SystemExit(f"{sorted(per_file)} apply to --object files; give --object PATH")

@@ -18,15 +18,13 @@ def task_overrides(path: str | None) -> dict:
     """TaskConfig keys from a YAML file, applied to every category (validated when the env is made)."""
     if path is None:
         return {}
-    import yaml
-
     from capt_env.shipped_configs import resolve_config
+    from capt_env.tasks.config import read_task_yaml
 
-    path = str(resolve_config("tasks", path))
-    with open(path) as fh:
-        raw = yaml.safe_load(fh) or {}
-    if not isinstance(raw, dict):
-        raise SystemExit(f"--task {path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
+    try:
+        raw = read_task_yaml(resolve_config("tasks", path))
+    except (FileNotFoundError, ValueError) as err:
+        raise SystemExit(f"--task {path}: {err}") from err
     clash = sorted({"category", "object"} & set(raw))
     if clash:
         raise SystemExit(f"--task {path}: {clash} would override --categories/--object; remove them")

@@ -38,6 +38,7 @@ from lxml import etree
 from scipy.spatial.transform import Rotation
 
 from capt_env.objects.errors import ObjectFileError
+from capt_env.objects.urdf_text import format_floats as _fmt
 
 DEFAULT_DENSITY = 1000.0
 MIN_MASS = 1e-3  # kg, for a body without geometry (a frame for a latch or a handle)
@@ -223,8 +224,6 @@ class _Converter:
         self.out_dir = out_dir
         self.visual_groups = set(visual_groups)
         self.density = density
-        self.links: list[str] = []
-        self.joints: list[str] = []
         self.names: set[str] = set()
         self.movable: list[str] = []
         self.counter = 0
@@ -417,7 +416,6 @@ class _Converter:
 
     def write_joint(self, lines: list[str], name: str, jtype: str, parent: str, child: str,
                     origin: np.ndarray, extra: str = "") -> None:
-        self.joints.append(name)
         lines.append(f"  <joint name={quoteattr(name)} type={quoteattr(jtype)}>"
                      f"<parent link={quoteattr(parent)}/><child link={quoteattr(child)}/>"
                      f"{_origin(origin)}{extra}</joint>")
@@ -453,7 +451,6 @@ class _Converter:
 
     def write_link(self, lines: list[str], name: str, vis: list[str], col: list[str], masses: list,
                    inertial: etree._Element | None = None, to_link: np.ndarray | None = None) -> None:
-        self.links.append(name)
         mass, com, inertia = _inertial(masses, inertial, to_link, self)
         lines.append(f"  <link name={quoteattr(name)}>")
         terms = " ".join(f'i{a}="{inertia[i, j]:.9g}"' for a, (i, j) in _INERTIA_TERMS.items())
@@ -514,10 +511,6 @@ def _inertial(masses: list, inertial: etree._Element | None, to_link: np.ndarray
     if vals.min() < MIN_INERTIA:
         inertia = inertia + np.eye(3) * (MIN_INERTIA - min(vals.min(), 0.0))
     return total, com, inertia
-
-
-def _fmt(values: np.ndarray) -> str:
-    return " ".join(f"{float(v):.9g}" for v in np.asarray(values, dtype=np.float64).reshape(-1))
 
 
 def _origin(mat: np.ndarray) -> str:

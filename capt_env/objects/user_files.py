@@ -29,6 +29,7 @@ from mani_skill.utils.structs import Articulation
 
 from capt_env.objects.errors import ObjectFileError
 from capt_env.objects.spec import ObjectSpec
+from capt_env.objects.urdf_text import format_floats as _fmt
 
 URDF_SUFFIXES = (".urdf",)
 MJCF_SUFFIXES = (".xml", ".mjcf")
@@ -301,10 +302,6 @@ def _file_joint_name(sim_name: str, *tables: dict[str, float]) -> str:
             if sim_name == file_name or sim_name.endswith(file_name):
                 return file_name
     return sim_name
-
-
-def _fmt(values: Any) -> str:
-    return " ".join(f"{float(v):.9g}" for v in np.asarray(values, dtype=np.float64).reshape(-1))
 
 
 def _rpy_from_quat(quat: Any) -> np.ndarray:

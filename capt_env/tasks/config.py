@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from pathlib import Path
+from typing import Any, Literal
 
 from perception.yaml_config import ConfigError, require
 
@@ -194,3 +195,20 @@ USER_FILE_KEYS = ("joint", "front_yaw", "closed", "joint_damping", "joint_fricti
                   "grasp_point", "handle", "visual_groups", "mjcf_angle")
 """Task keys that describe a user object file and need ``object``."""
 _DEFAULTS = TaskConfig(category="laptop")
+
+
+def read_task_yaml(path: str | Path) -> dict[str, Any]:
+    """The TaskConfig keys of a YAML file, as a mapping (validated where it is used).
+
+    :raises FileNotFoundError: if the file does not exist.
+    :raises ValueError: if it does not hold a mapping.
+    """
+    import yaml
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"task file not found: {path}")
+    raw = yaml.safe_load(path.read_text()) or {}
+    if not isinstance(raw, dict):
+        raise ValueError(f"{path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
+    return raw

@@ -159,7 +159,7 @@ def _load_user_file(scene: Any, cfg: TaskConfig) -> LoadedObject:
         set_link_mass(joints[target].child_link, cfg.part_mass)
     aabb = _articulation_aabb(art)
     grasp_link = joints[target].child_link
-    grasp = _user_grasp_target(art, joints[target], type_ids[target], float(open_sign[target]), aabb, cfg)
+    grasp = _user_grasp_target(art, joints, target, type_ids[target], float(open_sign[target]), aabb, cfg)
     front = cfg.front_yaw_radians()
     if front is None:
         front = _guess_front_azimuth(art, grasp_link, grasp, aabb)
@@ -262,24 +262,14 @@ def _pose_matrix(entity_pose: Any) -> np.ndarray:
     return entity_pose.to_transformation_matrix()[0].cpu().numpy().astype(np.float64)
 
 
-def _part_meshes(art: Articulation, part: Link) -> tuple[list, list[str]]:
-    """Meshes of a moving part, in its link's frame: the link and every link fixed to it."""
+def _part_meshes(art: Articulation, joints: list[ArticulationJoint], k: int) -> tuple[list, list[str]]:
+    """Meshes of the part movable joint ``k`` moves (its child link and every link fixed to it, as in
+    :func:`link_parts`), in the child link's frame, with the link each came from."""
+    part = joints[k].child_link
     inv = np.linalg.inv(_pose_matrix(part.pose))
-    rigid = {part.name}
-    changed = True
-    while changed:
-        changed = False
-        for link in art.links:
-            joint = link.joint
-            parent = joint.parent_link
-            if link.name in rigid or parent is None or _joint_type_name(joint) != "fixed":
-                continue
-            if parent.name in rigid:
-                rigid.add(link.name)
-                changed = True
     meshes, owners = [], []
-    for link in art.links:
-        if link.name not in rigid:
+    for link, label in zip(art.links, link_parts(art, joints), strict=True):
+        if label != k + 1:
             continue
         rel = inv @ _pose_matrix(link.pose)
         for m in link_shape_meshes(link):
@@ -288,15 +278,17 @@ def _part_meshes(art: Articulation, part: Link) -> tuple[list, list[str]]:
     return meshes, owners
 
 
-def _user_grasp_target(art: Articulation, joint: ArticulationJoint, type_id: int, sign: float,
-                       aabb: tuple[np.ndarray, np.ndarray], cfg: TaskConfig) -> GraspTarget:
-    """The grasp target of the moving part (see :mod:`capt_env.tasks.grasp_target`), link frame."""
+def _user_grasp_target(art: Articulation, joints: list[ArticulationJoint], k: int, type_id: int,
+                       sign: float, aabb: tuple[np.ndarray, np.ndarray], cfg: TaskConfig) -> GraspTarget:
+    """The grasp target of the part joint ``k`` moves (see :mod:`capt_env.tasks.grasp_target`), in
+    its child link's frame."""
+    joint = joints[k]
     part = joint.child_link
     inv = np.linalg.inv(_pose_matrix(part.pose))
     joint_mat = inv @ _pose_matrix(joint.get_global_pose())
     axis, pivot = sign * joint_mat[:3, 0], joint_mat[:3, 3]
     centre = inv[:3, :3] @ ((aabb[0] + aabb[1]) / 2) + inv[:3, 3]
-    meshes, owners = _part_meshes(art, part)
+    meshes, owners = _part_meshes(art, joints, k)
     found = find_grasp_target(meshes, owners, axis, pivot, type_id == 0, centre, handle=cfg.handle,
                               part_name=part.name)
     if cfg.grasp_point is None:

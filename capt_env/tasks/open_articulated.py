@@ -53,8 +53,9 @@ from mani_skill.utils import sapien_utils
 from mani_skill.utils.scene_builder.table import TableSceneBuilder
 from mani_skill.utils.structs import Articulation, Pose
 
+from capt_env.registration import GENERIC_ID
 from capt_env.rendering import translate_render_error
-from capt_env.tasks.config import TaskConfig
+from capt_env.tasks.config import TaskConfig, read_task_yaml
 from capt_env.tasks.object_loading import LoadedObject, load_object
 from perception.yaml_config import from_dict
 
@@ -104,7 +105,7 @@ class OpenArticulatedEnv(BaseEnv):
         where = "task"
         if isinstance(task, (str, Path)):  # a YAML file of TaskConfig keys
             where = str(task)
-            task = _read_task_yaml(Path(task))
+            task = read_task_yaml(task)
         if isinstance(task, TaskConfig):
             base = dataclasses.asdict(task)
             base["cameras"] = list(task.cameras)
@@ -115,9 +116,9 @@ class OpenArticulatedEnv(BaseEnv):
                 continue
             if key in base and base[key] is not None and base[key] != value:
                 raise ValueError(f"{where}: {key}={base[key]!r} conflicts with this env id's "
-                                 f"{key}={value!r}; use {GENERIC_NAME} for any {key}")
+                                 f"{key}={value!r}; use {GENERIC_ID} for any {key}")
             if key == "category" and base.get("object") is not None:
-                raise ValueError(f"{where}: object={base['object']!r} on a category id; use {GENERIC_NAME} "
+                raise ValueError(f"{where}: object={base['object']!r} on a category id; use {GENERIC_ID} "
                                  "for user files")
             base[key] = value
         self.task_config: TaskConfig = from_dict(TaskConfig, base, where=where)
@@ -351,16 +352,3 @@ class OpenArticulatedEnv(BaseEnv):
 
 
 _TASK_FIELDS = {f.name for f in dataclasses.fields(TaskConfig)}
-GENERIC_NAME = "CaptOpenArticulated-v0"
-
-
-def _read_task_yaml(path: Path) -> dict:
-    """TaskConfig keys from a YAML file (validated with the file named in errors)."""
-    import yaml
-
-    if not path.is_file():
-        raise FileNotFoundError(f"task file not found: {path}")
-    raw = yaml.safe_load(path.read_text()) or {}
-    if not isinstance(raw, dict):
-        raise ValueError(f"{path}: expected a mapping of TaskConfig keys, got {type(raw).__name__}")
-    return raw
