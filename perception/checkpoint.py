@@ -21,8 +21,8 @@ from typing import Any
 
 import torch
 
+from capt_common.typed_yaml import ConfigError, from_dict, to_dict
 from perception.config import CaptConfig
-from perception.yaml_config import ConfigError, from_dict, to_dict
 
 FORMAT_VERSION = 1
 

@@ -1,6 +1,6 @@
 """Configuration of CAPT (paper Sec. III): model variant and sizes, loss weights W, double-voting window.
 
-Every dataclass mirrors a YAML mapping one to one (see :mod:`perception.yaml_config`); defaults live
+Every dataclass mirrors a YAML mapping one to one (see :mod:`capt_common.typed_yaml`); defaults live
 here. Variants:
 
 - ``capt``: PCT encoder, segmentation + per-point articulation branches, motion loss, double voting.
@@ -17,8 +17,8 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
+from capt_common.typed_yaml import require
 from perception.corruption import Corruption
-from perception.yaml_config import require
 
 Variant = Literal["capt", "capt_plain", "pct_regression"]
 JointType = Literal["revolute", "prismatic"]

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from capt_env.commands.json_output import script_command, write_json
+from capt_common.json_report import script_command, write_json
 from perception.checkpoints import default_checkpoint
 from perception.data import CaptShardDataset
 from perception.inference import ArticulationEstimator

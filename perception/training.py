@@ -20,13 +20,13 @@ import torch
 from torch.utils.data import DataLoader
 from tqdm import tqdm
 
+from capt_common.typed_yaml import to_dict
 from perception.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
 from perception.config import JOINT_TYPE_CODES, TrainConfig
 from perception.data import CaptShardDataset
 from perception.losses import capt_losses
 from perception.model import CaptModel, CaptOutput
 from perception.voting import PointPredictions, choose_voting_window
-from perception.yaml_config import to_dict
 
 LOSS_NAMES = ("total", "seg", "dir", "pdir", "dist", "state", "motion", "pivot")
 

@@ -17,7 +17,7 @@ import argparse
 import json
 from pathlib import Path
 
-from capt_env.commands.json_output import script_command, write_json
+from capt_common.json_report import script_command, write_json
 from perception.data import load_split
 
 

@@ -41,7 +41,7 @@ import statistics
 from collections.abc import Callable
 from pathlib import Path
 
-from capt_env.commands.json_output import script_command, write_json, write_markdown
+from capt_common.json_report import script_command, write_json, write_markdown
 from perception.paired_comparison import METRICS as PAIRED_METRICS
 from perception.paired_comparison import RESAMPLE_UNITS, PairedDifference, paired_differences
 

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from capt_env.commands.json_output import script_command, write_json, write_markdown
+from capt_common.json_report import script_command, write_json, write_markdown
 from perception.data import load_split
 from perception.paired_comparison import METRICS, RESAMPLE_UNITS, paired_differences
 

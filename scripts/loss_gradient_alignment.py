@@ -23,7 +23,7 @@ import torch
 from torch.utils.data import DataLoader
 from tqdm import tqdm
 
-from capt_env.commands.json_output import script_command, write_json, write_markdown
+from capt_common.json_report import script_command, write_json, write_markdown
 from perception.checkpoint import CheckpointError, build_model, load_checkpoint
 from perception.data import CaptShardDataset
 from perception.gradient_alignment import LOSS_TERMS, PARAMETER_GROUPS, alignments, term_gradients

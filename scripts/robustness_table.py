@@ -18,7 +18,7 @@ import argparse
 import json
 from pathlib import Path
 
-from capt_env.commands.json_output import script_command, write_json, write_markdown
+from capt_common.json_report import script_command, write_json, write_markdown
 
 METRICS = (("dir_med", "direction (deg)", ".2f"), ("pos_aed", "position (normalised)", ".4f"),
            ("state_deg", "state (deg)", ".2f"))

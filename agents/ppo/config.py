@@ -6,10 +6,10 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from agents.scripted.config import ScriptedOpenerConfig
+from capt_common.typed_yaml import from_dict, require
 from capt_env.registration import CATEGORY_ENV_NAMES, MAX_EPISODE_STEPS
 from capt_env.tasks.config import TaskConfig
 from capt_env.wrappers.config import PerceptionWrapperConfig
-from perception.yaml_config import from_dict, require
 
 ObsMode = Literal["state", "pointcloud"]
 VecEnvKind = Literal["processes", "maniskill"]

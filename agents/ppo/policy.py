@@ -19,7 +19,7 @@ from stable_baselines3.common.vec_env import VecNormalize
 from agents.ppo.residual import RESIDUAL_OBSERVATION_SIZE, ResidualComposer
 from agents.ppo.train import CONFIG_FILE, vecnormalize_path
 from agents.scripted.config import ScriptedOpenerConfig
-from perception.yaml_config import from_dict
+from capt_common.typed_yaml import from_dict
 
 CONSTANT_FEATURE_VAR = 1e-6
 """Training variance under which an observation feature counts as constant (see :class:`PPOPolicy`):

@@ -41,7 +41,7 @@ from stable_baselines3.common.utils import set_random_seed
 from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecNormalize
 
 from agents.ppo.config import PPOTrainConfig
-from perception.yaml_config import ConfigError, from_dict, to_dict
+from capt_common.typed_yaml import ConfigError, from_dict, to_dict
 
 CHECKPOINT_PREFIX = "ppo"
 FINAL_MODEL = "final.zip"
@@ -86,7 +86,7 @@ def make_train_env(config: PPOTrainConfig, rank: int) -> gym.Env:
     """Env number ``rank`` of a training run: train split, wrapped, with ``Monitor`` (records
     episode return, length and the task's ``success`` at the episode's last step)."""
     import capt_env  # noqa: F401 - registers the ids in a fresh worker process
-    from agents.scripted.rollout import make_env
+    from capt_env.env_factory import make_env
 
     perception = replace(config.perception, seed=config.perception.seed + rank)
     env: gym.Env = make_env(config.category, perception, task=config.train_task(),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from perception.yaml_config import require
+from capt_common.typed_yaml import require
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ import time
 
 from tqdm import tqdm
 
-from capt_env.commands.json_output import write_json
+from capt_common.json_report import write_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -62,7 +62,7 @@ def measure_with_capt(category: str, every_k: int, steps: int, width: int, seed:
     """Steps/s of the pointcloud env wrapped with CAPT perception run every ``every_k`` steps. The
     wrapper renders only on perception steps; ``render_every_step`` times the path it replaced (the
     cameras rendered on every step), for an A/B in one run."""
-    from agents.scripted.rollout import make_env
+    from capt_env.env_factory import make_env
     from perception.checkpoints import default_checkpoint
 
     wrapper = {"source": "capt", "checkpoint": str(default_checkpoint(category)), "every_k_steps": every_k}

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from capt_env.commands.json_output import write_json
+from capt_common.json_report import write_json
 from capt_env.commands.object_targets import add_object_arguments, object_targets, target_task
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 

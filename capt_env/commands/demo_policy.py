@@ -15,7 +15,7 @@ def open_with_capt(category: str | None, checkpoint: str | Path, seed: int, out_
     import numpy as np
 
     from agents.scripted.opener import Phase, ScriptedOpener
-    from agents.scripted.rollout import make_env
+    from capt_env.env_factory import make_env
 
     wrapper = {"source": "capt", "checkpoint": str(checkpoint), "every_k_steps": every_k_steps}
     env = make_env(category, wrapper, task=task, obs_mode="pointcloud",

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from capt_env.commands.json_output import machine_info, write_json
+from capt_common.json_report import machine_info, write_json
 from capt_env.rendering import INSTALL_HINT, device_summary, mesa_version, renderer_works
 
 

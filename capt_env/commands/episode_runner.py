@@ -39,8 +39,8 @@ class EpisodeJob:
     def identity(self) -> dict[str, Any]:
         """What makes two evaluations the same (the key of :class:`EpisodeLog` records): everything
         that decides an episode given its seed."""
+        from capt_common.typed_yaml import from_dict, to_dict
         from capt_env.wrappers.config import NoiseConfig
-        from perception.yaml_config import from_dict, to_dict
 
         identity = {"category": self.category, "policy": self.policy, "model": self.model,
                     "perception": self.wrapper["source"], "checkpoint": self.wrapper.get("checkpoint"),
@@ -52,7 +52,7 @@ class EpisodeJob:
 
     def build(self) -> tuple[Any, Any]:
         """A fresh wrapped env and policy."""
-        from agents.scripted.rollout import make_env
+        from capt_env.env_factory import make_env
 
         if self.policy == "ppo":
             from agents.ppo.policy import PPOPolicy

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from capt_env.commands.json_output import write_json
+from capt_common.json_report import write_json
 from capt_env.commands.object_targets import add_object_arguments, object_targets, target_task
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 from capt_env.wrappers.config import PerceptionWrapperConfig
@@ -83,7 +83,7 @@ def _cm(v: float | None) -> str:
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from agents.scripted.rollout import make_env
+    from capt_env.env_factory import make_env
     from capt_env.wrappers.perception_sources import ground_truth_estimate
     from perception.checkpoints import default_checkpoint
 

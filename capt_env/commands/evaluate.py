@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from capt_env.commands.json_output import write_json
+from capt_common.json_report import write_json
 
 if TYPE_CHECKING:
     from perception.corruption import Corruption

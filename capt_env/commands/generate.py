@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from capt_env.commands.json_output import write_json
+from capt_common.json_report import write_json
 from capt_env.commands.object_targets import add_object_arguments, object_targets
 
 
@@ -27,10 +27,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     import dataclasses
 
+    from capt_common.typed_yaml import load_yaml
     from capt_env.dataset.config import GenerateConfig
     from capt_env.dataset.generator import generate
     from capt_env.shipped_configs import resolve_config
-    from perception.yaml_config import load_yaml
 
     cfg = GenerateConfig()
     if args.config:

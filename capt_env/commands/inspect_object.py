@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from capt_env.commands.json_output import write_json
+from capt_common.json_report import write_json
 
 PANDA_SHOULDER_HEIGHT = 0.333
 """m: height of the Panda's second joint above its base (the centre of its reach sphere)."""

@@ -37,8 +37,8 @@ def noise_overrides(items: list[str]) -> dict[str, Any]:
 
 def check_noise(overrides: dict[str, Any]) -> None:
     """SystemExit naming the key when NoiseConfig ``overrides`` are unknown or out of range."""
+    from capt_common.typed_yaml import ConfigError, from_dict
     from capt_env.wrappers.config import NoiseConfig
-    from perception.yaml_config import ConfigError, from_dict
 
     try:
         from_dict(NoiseConfig, overrides, where="noise").validate()
@@ -48,7 +48,7 @@ def check_noise(overrides: dict[str, Any]) -> None:
 
 def resolved_noise(overrides: dict[str, Any]) -> dict[str, Any]:
     """Every NoiseConfig field, ``overrides`` applied to the defaults (what a JSON report records)."""
+    from capt_common.typed_yaml import from_dict, to_dict
     from capt_env.wrappers.config import NoiseConfig
-    from perception.yaml_config import from_dict, to_dict
 
     return to_dict(from_dict(NoiseConfig, overrides, where="noise"))

@@ -83,11 +83,11 @@ def sweep_table(parameter: str, rows: list[dict[str, Any]]) -> str:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from capt_common.json_report import write_json
+    from capt_common.typed_yaml import to_dict
     from capt_env.commands.episode_log import EpisodeLog
     from capt_env.commands.episode_runner import EpisodeJob, play_episodes
-    from capt_env.commands.json_output import write_json
     from capt_env.commands.rollout import opener_config, ppo_model, success_row
-    from perception.yaml_config import to_dict
 
     if args.episodes < 1:
         raise SystemExit(f"--episodes must be at least 1, got {args.episodes}")

@@ -7,12 +7,12 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from capt_common.json_report import write_json
+from capt_common.typed_yaml import to_dict
 from capt_env.commands.episode_log import EpisodeLog
-from capt_env.commands.json_output import write_json
 from capt_env.commands.noise_overrides import add_noise_argument, noise_overrides, resolved_noise
 from capt_env.commands.object_targets import add_object_arguments, object_targets, target_task
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
-from perception.yaml_config import to_dict
 
 if TYPE_CHECKING:
     from agents.scripted.config import ScriptedOpenerConfig
@@ -51,8 +51,8 @@ def opener_config(path: str | None) -> ScriptedOpenerConfig:
     """The scripted opener's config: its defaults, overridden by the keys of YAML ``path`` (unknown
     keys and bad values exit with a message naming them)."""
     from agents.scripted.config import ScriptedOpenerConfig
+    from capt_common.typed_yaml import ConfigError, load_yaml
     from capt_env.shipped_configs import resolve_config
-    from perception.yaml_config import ConfigError, load_yaml
 
     if path is None:
         return ScriptedOpenerConfig()

@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from capt_env.commands.json_output import write_json
+from capt_common.json_report import write_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -32,9 +32,9 @@ def train_config_for(config_path: str, data_dir: str, epochs: int | None, device
     """The YAML TrainConfig with the model's output channels set for the dataset's category, and the
     command line's overrides (``None``: keep the config's)."""
 
+    from capt_common.typed_yaml import from_dict, load_yaml, to_dict
     from capt_env.dataset.category_structure import category_structure
     from perception.config import TrainConfig
-    from perception.yaml_config import from_dict, load_yaml, to_dict
 
     manifest = Path(data_dir) / "manifest.json"
     if not manifest.is_file():

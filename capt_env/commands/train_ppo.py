@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from capt_env.commands.json_output import write_json
+from capt_common.json_report import write_json
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -26,8 +26,8 @@ def _fmt(value: float | None, spec: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from agents.ppo.config import PPOTrainConfig
     from agents.ppo.train import train_ppo
+    from capt_common.typed_yaml import ConfigError, from_dict, load_yaml, to_dict
     from capt_env.shipped_configs import resolve_config
-    from perception.yaml_config import ConfigError, from_dict, load_yaml, to_dict
 
     cfg = to_dict(load_yaml(PPOTrainConfig, resolve_config("ppo", args.config)))
     if args.total_timesteps is not None:

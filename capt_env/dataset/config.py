@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from capt_common.typed_yaml import require
 from capt_env.tasks.config import CameraConfig
-from perception.yaml_config import require
 
 # Joint slots stored per sample; a category with fewer joints leaves the rest masked out.
 MAX_JOINTS = 4

@@ -41,8 +41,8 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
+from capt_common.typed_yaml import to_dict
 from capt_env.dataset.config import MAX_JOINTS, GenerateConfig
-from perception.yaml_config import to_dict
 
 SPLITS = ("train", "val", "test")
 MANIFEST = "manifest.json"
@@ -191,7 +191,7 @@ def write_npz_atomic(path: Path, arrays: dict[str, np.ndarray]) -> None:
 
 def _work(payload: tuple[str, ShardJob, str]) -> tuple[ShardJob, int]:
     cfg_json, job, out_dir = payload
-    from perception.yaml_config import from_dict
+    from capt_common.typed_yaml import from_dict
 
     cfg = from_dict(GenerateConfig, json.loads(cfg_json))
     arrays = render_shard(cfg, job)
@@ -200,7 +200,7 @@ def _work(payload: tuple[str, ShardJob, str]) -> tuple[ShardJob, int]:
 
 
 def _write_manifest(out_dir: Path, cfg: GenerateConfig, extra: dict) -> None:
-    from capt_env.commands.json_output import machine_info
+    from capt_common.json_report import machine_info
 
     data = {"format": "capt-env-shards/1", "config": to_dict(cfg), "seed": cfg.seed,
             "versions": machine_info(), **extra}

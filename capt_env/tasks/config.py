@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-from perception.yaml_config import ConfigError, require
+from capt_common.typed_yaml import ConfigError, require
 
 Split = Literal["train", "val", "test", "all"]
 ClosedLimit = Literal["auto", "lower", "upper"]

@@ -53,11 +53,11 @@ from mani_skill.utils import sapien_utils
 from mani_skill.utils.scene_builder.table import TableSceneBuilder
 from mani_skill.utils.structs import Articulation, Pose
 
+from capt_common.typed_yaml import from_dict
 from capt_env.registration import GENERIC_ID
 from capt_env.rendering import translate_render_error
 from capt_env.tasks.config import TaskConfig, read_task_yaml
 from capt_env.tasks.object_loading import LoadedObject, load_object
-from perception.yaml_config import from_dict
 
 JOINT_TYPE_IDS = {"revolute": 0, "prismatic": 1}
 # End-effector deltas: [-1, 1] maps to +-0.1 m / +-0.1 rad per 20 Hz control step (ManiSkill 3.0.1

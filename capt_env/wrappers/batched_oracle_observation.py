@@ -31,9 +31,9 @@ from typing import Any
 import gymnasium as gym
 import torch
 
+from capt_common.typed_yaml import ConfigError, from_dict
 from capt_env.wrappers.config import NoiseConfig, PerceptionWrapperConfig
 from capt_env.wrappers.joint_observation import OBSERVATION_SIZE, flat_space
-from perception.yaml_config import ConfigError, from_dict
 
 _EPS = 1e-9
 

@@ -1,11 +1,11 @@
-"""Typed configs of the perception wrapper and of object isolation (YAML via perception.yaml_config)."""
+"""Typed configs of the perception wrapper and of object isolation (YAML via capt_common.typed_yaml)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Literal
 
-from perception.yaml_config import require
+from capt_common.typed_yaml import require
 
 Source = Literal["oracle", "noisy_oracle", "capt"]
 IsolationMode = Literal["segmentation", "geometric"]

@@ -23,13 +23,13 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from capt_common.typed_yaml import from_dict
 from capt_env.wrappers.config import PerceptionWrapperConfig
 from capt_env.wrappers.estimate import JointAxisEstimate
 from capt_env.wrappers.joint_observation import build_dict, dict_space, flat_space, flatten
 from capt_env.wrappers.object_isolation import isolate
 from capt_env.wrappers.perception_sources import PerceptionSource, make_source
 from capt_env.wrappers.robot_filter import RobotPointFilter
-from perception.yaml_config import from_dict
 
 
 def downsample(points: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:

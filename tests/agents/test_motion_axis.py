@@ -11,7 +11,8 @@ from agents.scripted.config import ScriptedOpenerConfig
 from agents.scripted.geometry import axis_angle_matrix
 from agents.scripted.motion_axis import fit_motion_axis
 from agents.scripted.opener import ScriptedOpener
-from agents.scripted.rollout import make_env, run_episode
+from agents.scripted.rollout import run_episode
+from capt_env.env_factory import make_env
 
 FIT = {"min_travel": 0.03, "min_angle": 0.4, "max_rms": 0.004, "max_turn": 0.6, "max_ratio": 0.1}
 

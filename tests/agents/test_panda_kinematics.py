@@ -19,7 +19,7 @@ from agents.scripted.panda_kinematics import (
     pose_matrix,
     tcp_pose,
 )
-from agents.scripted.rollout import make_env
+from capt_env.env_factory import make_env
 from capt_env.wrappers.joint_observation import decode_observation
 
 _HOME = np.array([0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 0.8])  # near ManiSkill's reset pose, hand down

@@ -16,8 +16,8 @@ from agents.ppo.config import PPOTrainConfig
 from agents.ppo.policy import PPOPolicy
 from agents.ppo.train import ContinueAfterSuccess, latest_checkpoint, train_ppo
 from agents.scripted.config import ScriptedOpenerConfig
-from agents.scripted.rollout import make_env
-from perception.yaml_config import ConfigError, from_dict, load_yaml
+from capt_common.typed_yaml import ConfigError, from_dict, load_yaml
+from capt_env.env_factory import make_env
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY = {"category": "laptop", "perception": {"source": "noisy_oracle", "every_k_steps": 2},

@@ -18,11 +18,11 @@ from agents.ppo.config import PPOTrainConfig
 from agents.ppo.maniskill_vec_env import ManiSkillVecEnv
 from agents.ppo.policy import PPOPolicy
 from agents.ppo.train import make_vec_env, train_ppo
-from agents.scripted.rollout import make_env
+from capt_common.typed_yaml import ConfigError, from_dict
+from capt_env.env_factory import make_env
 from capt_env.wrappers.batched_oracle_observation import BatchedOracleObservation, ground_truth
 from capt_env.wrappers.joint_observation import OBSERVATION_SIZE, observation_layout
 from perception.metrics import direction_error_deg, line_distance
-from perception.yaml_config import ConfigError, from_dict
 
 LAYOUT = observation_layout()
 

@@ -19,9 +19,9 @@ from agents.ppo.residual import (
 )
 from agents.ppo.train import train_ppo
 from agents.scripted.opener import Phase, ScriptedOpener
-from agents.scripted.rollout import make_env
+from capt_common.typed_yaml import from_dict
+from capt_env.env_factory import make_env
 from capt_env.wrappers.joint_observation import OBSERVATION_SIZE
-from perception.yaml_config import from_dict
 
 SEED = 5
 

@@ -20,9 +20,10 @@ from agents.scripted.grasp_pose import (
 )
 from agents.scripted.opener import ACTION_SCALE_M, Phase
 from agents.scripted.panda_kinematics import tcp_pose
-from agents.scripted.rollout import make_env, run_episode
+from agents.scripted.rollout import run_episode
+from capt_common.typed_yaml import ConfigError, from_dict
+from capt_env.env_factory import make_env
 from capt_env.wrappers.estimate import JointAxisEstimate, unit
-from perception.yaml_config import ConfigError, from_dict
 
 
 def test_outward_normal_of_a_door_points_at_the_robot() -> None:

@@ -42,9 +42,9 @@ def test_bench_writes_numbers(tmp_path: Path) -> None:
 
 
 def test_rollout_task_overrides_load_and_reject_a_category(tmp_path: Path) -> None:
+    from capt_common.typed_yaml import from_dict
     from capt_env.commands.task_overrides import task_overrides
     from capt_env.tasks.config import TaskConfig
-    from perception.yaml_config import from_dict
 
     repo = Path(__file__).resolve().parents[2]
     task = task_overrides(str(repo / "configs/tasks/two_cameras.yaml"))
@@ -146,8 +146,8 @@ def test_estimate_errors_hinge_on_door_edge_beats_capt_line(tmp_path: Path) -> N
 
 
 def test_train_config_takes_the_command_line_overrides(tmp_path: Path) -> None:
+    from capt_common.typed_yaml import ConfigError
     from capt_env.commands.train import train_config_for
-    from perception.yaml_config import ConfigError
 
     data = tmp_path / "data"
     data.mkdir()

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from capt_common.typed_yaml import ConfigError, from_dict
 from capt_env.dataset.config import MAX_JOINTS, GenerateConfig
 from capt_env.dataset.generator import generate, plan_shards, shard_path
 from capt_env.tasks.config import CameraConfig
-from perception.yaml_config import ConfigError, from_dict
 
 SMALL = GenerateConfig(
     category="drawer_cabinet",

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import capt_env
+from capt_common.typed_yaml import ConfigError
 from capt_env.registration import CATEGORY_ENV_NAMES, MAX_EPISODE_STEPS, env_id
-from perception.yaml_config import ConfigError
 
 ZERO = np.zeros(7, np.float32)
 

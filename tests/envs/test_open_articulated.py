@@ -9,9 +9,9 @@ import torch
 from gymnasium.utils.env_checker import check_env
 
 import capt_env  # noqa: F401 - registers the env ids
+from capt_common.typed_yaml import ConfigError
 from capt_env.objects.registry import CATEGORIES
 from capt_env.registration import GENERIC_ID, env_id
-from perception.yaml_config import ConfigError
 
 CAMERA = {"name": "depth_camera", "eye": [-0.45, -0.3, 0.45], "width": 96, "height": 96}
 

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 import torch
 
+from capt_common.typed_yaml import ConfigError, from_dict, load_yaml
 from perception.config import CaptConfig, ModelConfig, TrainConfig
 from perception.data import CaptShardDataset, Sample, augment, load_split, prepare_sample, write_dataset
 from perception.geometry import axis_targets
 from perception.normalisation import Normalisation
-from perception.yaml_config import ConfigError, from_dict, load_yaml
 
 from .helpers import make_samples, tiny_model_config
 

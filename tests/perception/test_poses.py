@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from capt_common.typed_yaml import ConfigError, load_yaml
 from perception.config import TrainConfig
 from perception.data import CaptShardDataset, posed_sample, write_dataset
 from perception.voting import point_axis_distance
-from perception.yaml_config import ConfigError, load_yaml
 
 from .helpers import make_samples, tiny_model_config
 

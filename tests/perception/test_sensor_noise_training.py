@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from capt_common.typed_yaml import ConfigError, load_yaml
 from perception.config import CaptConfig, TrainConfig
 from perception.corruption import Corruption
 from perception.data import CaptShardDataset, add_sensor_noise, write_dataset
 from perception.training import train
-from perception.yaml_config import ConfigError, load_yaml
 
 from .helpers import make_samples, tiny_model_config
 

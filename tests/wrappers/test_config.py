@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
+from capt_common.typed_yaml import ConfigError, from_dict, load_yaml
 from capt_env.wrappers.config import PerceptionWrapperConfig
-from perception.yaml_config import ConfigError, from_dict, load_yaml
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "wrappers"
 

@@ -9,11 +9,11 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import capt_env  # noqa: F401  (registers the ids)
+from capt_common.typed_yaml import ConfigError, from_dict
 from capt_env.wrappers import CaptObservationWrapper, observation_layout
 from capt_env.wrappers.config import NoiseConfig
 from capt_env.wrappers.joint_observation import OBSERVATION_SIZE, decode_observation
 from capt_env.wrappers.perception_sources import NoisyOracleSource, ground_truth_estimate
-from perception.yaml_config import ConfigError, from_dict
 
 TASK = {"split": "test", "object_xy": (0.3, 0.0)}
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from agents.scripted.opener import ScriptedOpener
-from agents.scripted.rollout import make_env
+from capt_env.env_factory import make_env
 
 CHECKPOINT = Path(__file__).resolve().parents[2] / "perception" / "checkpoints" / "drawer_cabinet.pt"
 

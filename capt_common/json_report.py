@@ -1,5 +1,6 @@
-"""Write a command's numbers as JSON (atomically), with the machine and versions that produced them, and
-its Markdown table headed by the command line."""
+"""Reports of a command's numbers: JSON written atomically with the command line, machine and versions
+that produced them (``write_json``), and a Markdown table headed by its command line
+(``write_markdown``, ``script_command``)."""
 
 from __future__ import annotations
 

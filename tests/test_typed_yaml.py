@@ -8,7 +8,7 @@ from typing import Literal
 
 import pytest
 
-from perception.yaml_config import ConfigError, from_dict, load_yaml, require, to_dict
+from capt_common.typed_yaml import ConfigError, from_dict, load_yaml, require, to_dict
 
 
 @dataclass(frozen=True)
