@@ -37,6 +37,9 @@ def _add_verb(sub: argparse._SubParsersAction, verb: str, with_arguments: bool) 
         return
     mod = importlib.import_module(f"capt_env.commands.{module}")
     mod.add_arguments(p)
+    from capt_env.commands.deprecated_flags import apply_deprecated_flags
+
+    apply_deprecated_flags(p, verb)  # old spellings: hidden, warn, still work for one release
     p.add_argument("--json", metavar="PATH", default=None, help="also write the numbers as JSON here")
     p.set_defaults(_run=mod.run)
 

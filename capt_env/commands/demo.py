@@ -25,12 +25,12 @@ OPENED_CATEGORIES = ("laptop", "oven", "washing_machine", "drawer_cabinet", "cab
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--category", default=None,
-                        help="object category (default: every category with a shipped checkpoint)")
+    parser.add_argument("--categories", nargs="*", default=None,
+                        help="object categories (default: every category with a shipped checkpoint, or "
+                             "none when user files are given)")
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
     parser.add_argument("--episodes", type=int, default=1, help="episodes per category")
-    parser.add_argument("--seed", type=int, default=0,
-                        help="first episode seed (episodes use seed, seed+1, ...)")
+    parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
     parser.add_argument("--out", default="outputs/demo", help="where PNGs and MP4s go")
     parser.add_argument("--no-policy", action="store_true", help="only estimate; do not open the object")
     parser.add_argument("--no-video", action="store_true", help="run the policy without recording MP4s")
@@ -83,9 +83,10 @@ def run(args: argparse.Namespace) -> int:
     from perception.inference import ArticulationEstimator
 
     files = bool(args.object or args.objects)
-    args.categories = [args.category] if args.category else ([] if files else shipped_categories())
+    if args.categories is None:
+        args.categories = [] if files else shipped_categories()
     if not args.categories and not files:
-        raise SystemExit("no shipped checkpoint found; pass --category and --checkpoint")
+        raise SystemExit("no shipped checkpoint found; pass --categories and --checkpoint")
     out_dir = Path(args.out)
     overrides = {"cameras": [{"width": 160, "height": 160}], **task_overrides(args.task)}
     report = []
@@ -102,11 +103,11 @@ def run(args: argparse.Namespace) -> int:
             for ep in range(args.episodes):
                 tag = f"{target.label}_episode{ep}"
                 row = {"object": target.label, "category": category,
-                       **estimate_episode(env, estimator, args.seed + ep, out_dir, tag)}
+                       **estimate_episode(env, estimator, args.first_seed + ep, out_dir, tag)}
                 if not args.no_policy and (category is None or category in OPENED_CATEGORIES):
                     from capt_env.commands.demo_policy import open_with_capt
 
-                    row.update(open_with_capt(category, ckpt, args.seed + ep, out_dir, tag,
+                    row.update(open_with_capt(category, ckpt, args.first_seed + ep, out_dir, tag,
                                               video=not args.no_video, task=task))
                 elif not args.no_policy:
                     row["not_opened"] = "estimate only: the scripted opener is not built for this category"

@@ -26,8 +26,9 @@ from capt_env.wrappers.estimate import JointAxisEstimate
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_object_arguments(parser, ["cabinet_door"])
-    parser.add_argument("--resets", type=int, default=8, help="resets (unseen instances) per category")
-    parser.add_argument("--first-seed", type=int, default=0, help="resets use seeds first..first+n-1")
+    parser.add_argument("--episodes", type=int, default=8,
+                        help="episodes (unseen instances, each estimated at its reset) per category")
+    parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
     parser.add_argument("--hinge-on-part-edge", default="both", choices=["both", "on", "off"],
                         help="score the wrapper with the hinge-on-edge check, without it, or both")
@@ -87,14 +88,14 @@ def run(args: argparse.Namespace) -> int:
     from capt_env.wrappers.perception_sources import ground_truth_estimate
     from perception.checkpoints import default_checkpoint
 
-    if args.resets < 1:
-        raise SystemExit(f"--resets must be >= 1, got {args.resets}")
+    if args.episodes < 1:
+        raise SystemExit(f"--episodes must be >= 1, got {args.episodes}")
     choices = {"both": [False, True], "on": [True], "off": [False]}
     switches = ("hinge_on_part_edge", "dense_geometry", "slide_along_front", "coplanar_panel")
     combos = [dict(zip(switches, values, strict=True)) for values in itertools.product(
         *(choices[getattr(args, name)] for name in switches))]
     panel_on = PerceptionWrapperConfig().panel_max_state
-    seeds = list(range(args.first_seed, args.first_seed + args.resets))
+    seeds = list(range(args.first_seed, args.first_seed + args.episodes))
     task = task_overrides(args.task)
     targets = object_targets(args)
     header = ("| object | hinge on part edge | dense geometry | slide along front | coplanar panel | "

@@ -73,7 +73,7 @@ def add_object_arguments(parser: argparse.ArgumentParser, categories_default: li
         parser.add_argument("--categories", nargs="*", default=categories_default,
                             help="procedural object categories (none when only user files are given)")
     parser.add_argument("--object", action="append", default=[], metavar="PATH",
-                        help="a user URDF/MJCF file (repeatable); evaluated beside --categories")
+                        help="a user URDF/MJCF file (repeatable); evaluated beside any categories given")
     parser.add_argument("--objects", default=None, metavar="FILE.yaml",
                         help="YAML listing user files with their options (see docs/user_objects.md)")
     parser.add_argument("--joint", default=None, help="with --object: the joint to open (default: first)")

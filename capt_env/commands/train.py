@@ -22,9 +22,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--stop-after", type=int, default=None,
                         help="run at most this many epochs now; run again to resume")
     parser.add_argument("--no-resume", action="store_true", help="start over even if last.pt exists")
-    parser.add_argument("--init-from", default=None,
-                        help="checkpoint whose weights start a new run (fine-tune, e.g. a shipped one); "
-                             "ignored when resuming from last.pt")
+    parser.add_argument("--init-checkpoint", default=None,
+                        help="CAPT checkpoint whose weights start a new run (fine-tune, e.g. a shipped "
+                             "one); ignored when resuming from last.pt")
 
 
 def train_config_for(config_path: str, data_dir: str, epochs: int | None, device: str | None,
@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
 
     cfg, category = train_config_for(args.config, args.data, args.epochs, args.device, args.seed)
     result = train(cfg, args.data, args.out, resume=not args.no_resume, stop_after=args.stop_after,
-                   init_from=args.init_from)
+                   init_from=args.init_checkpoint)
     print(f"{category} {cfg.model.model.variant}: {result.epochs_run}/{cfg.epochs} epochs, "
           f"best val loss {result.best_val_loss:.4f}, voting window {result.voting_window}, "
           f"best checkpoint {result.best_path}")
@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
         "category": category, "variant": cfg.model.model.variant, "epochs_run": result.epochs_run,
         "epochs": cfg.epochs, "seed": cfg.seed, "best_val_loss": result.best_val_loss,
         "voting_window": list(result.voting_window), "best_path": str(result.best_path),
-        "log": str(result.log_path), "init_from": args.init_from,
+        "log": str(result.log_path), "init_from": args.init_checkpoint,
         "epoch_seconds": epoch_seconds(result.log_path),
     })
     return 0

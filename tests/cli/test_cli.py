@@ -90,7 +90,7 @@ def test_demo_estimates_an_unseen_object_with_the_shipped_checkpoint(tmp_path: P
     """The main job's estimation half: shipped checkpoint, two cameras, an accurate axis and a PNG."""
     out = tmp_path / "demo.json"
     task = Path(__file__).resolve().parents[2] / "configs" / "tasks" / "two_cameras.yaml"
-    assert main(["demo", "--category", "oven", "--episodes", "1", "--no-policy", "--task", str(task),
+    assert main(["demo", "--categories", "oven", "--episodes", "1", "--no-policy", "--task", str(task),
                  "--out", str(tmp_path), "--json", str(out)]) == 0
     (episode,) = json.loads(out.read_text())["episodes"]
     assert episode["category"] == "oven" and Path(episode["png"]).is_file()
@@ -105,7 +105,7 @@ def test_demo_estimates_eyeglasses_without_opening_them(tmp_path: Path, capsys) 
 
     out = tmp_path / "demo.json"
     assert "eyeglasses" not in OPENED_CATEGORIES and "oven" in OPENED_CATEGORIES
-    assert main(["demo", "--category", "eyeglasses", "--episodes", "1", "--out", str(tmp_path),
+    assert main(["demo", "--categories", "eyeglasses", "--episodes", "1", "--out", str(tmp_path),
                  "--json", str(out)]) == 0
     (episode,) = json.loads(out.read_text())["episodes"]
     assert "success" not in episode and episode["not_opened"].startswith("estimate only")
@@ -136,7 +136,7 @@ def test_estimate_errors_hinge_on_door_edge_beats_capt_line(tmp_path: Path) -> N
     off as CAPT's own (the session-23 model's own: 1.6 and 6.5 cm; on the edge 2.8 and 0.1 cm)."""
     out = tmp_path / "errors.json"
     repo = Path(__file__).resolve().parents[2]
-    assert main(["estimate-errors", "--categories", "cabinet_door", "--resets", "2",
+    assert main(["estimate-errors", "--categories", "cabinet_door", "--episodes", "2",
                  "--task", str(repo / "configs/tasks/two_cameras.yaml"), "--json", str(out)]) == 0
     off, on = json.loads(out.read_text())["results"]
     assert not off["hinge_on_part_edge"] and on["hinge_on_part_edge"]

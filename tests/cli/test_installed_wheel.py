@@ -51,7 +51,7 @@ def test_the_wheel_runs_outside_the_repository(installed: Path, tmp_path: Path) 
     assert where.returncode == 0, where.stderr[-2000:]
     train_help = _run(installed, "train", "--help", cwd=tmp_path)
     assert train_help.returncode == 0 and "(default: capt)" in " ".join(train_help.stdout.split())
-    demo = _run(installed, "demo", "--no-policy", "--category", "laptop", "--task", "two_cameras",
+    demo = _run(installed, "demo", "--no-policy", "--categories", "laptop", "--task", "two_cameras",
                 "--out", str(tmp_path / "demo"), cwd=tmp_path)
     assert demo.returncode == 0, demo.stderr[-2000:]
     assert "laptop_episode0" in demo.stdout and list((tmp_path / "demo").glob("*.png"))
