@@ -1,11 +1,12 @@
 """Gymnasium conventions of the -v0 ids: episode limits, seeding, task arguments, ManiSkill wrappers,
-vector envs, and the determinism check on the wrapped env."""
+vector envs, the determinism check on the wrapped env, and Stable-Baselines3's env checker."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
 import textwrap
+import warnings
 from pathlib import Path
 
 import gymnasium as gym
@@ -103,3 +104,39 @@ def test_async_vector_env_with_fork_fails_fast_and_says_to_use_spawn() -> None:
     """)
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=240)
     assert "spawn" in result.stderr and "vector_kwargs={'context': 'spawn'}" in result.stderr
+
+
+SINGLE_IDS = [env_id(category) for category in CATEGORY_ENV_NAMES] + [capt_env.registration.GENERIC_ID]
+
+
+def _sb3_check(env: gym.Env) -> None:
+    """SB3's checker with its extra warnings on; any warning it raises (not the libraries' deprecation
+    notices) fails the test."""
+    from stable_baselines3.common.env_checker import check_env
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_env(env, warn=True, skip_render_check=True)
+    assert [str(w.message) for w in caught if issubclass(w.category, UserWarning)] == []
+
+
+@pytest.mark.parametrize("env_name", SINGLE_IDS)
+def test_sb3_env_checker_on_every_single_env_id(env_name: str) -> None:
+    """Every standard (-v0) id passes SB3's checker in state mode. The -ms-v0 ids are ManiSkill's own
+    batched envs (torch tensors with a batch dimension), which SB3 reaches through the -v0 ids or
+    ManiSkill's ``ManiSkillSB3VectorEnv``, not as a single ``gym.Env``."""
+    task = {"category": "laptop"} if env_name == capt_env.registration.GENERIC_ID else None
+    env = gym.make(env_name, obs_mode="state", task=task)
+    try:
+        _sb3_check(env)
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("obs_format", ["flat", "dict"])
+def test_sb3_env_checker_on_the_wrapped_env(obs_format: str) -> None:
+    env = capt_env.make_env("drawer_cabinet", {"source": "noisy_oracle", "obs_format": obs_format})
+    try:
+        _sb3_check(env)
+    finally:
+        env.close()
