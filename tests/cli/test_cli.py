@@ -113,6 +113,22 @@ def test_demo_estimates_eyeglasses_without_opening_them(tmp_path: Path, capsys) 
     assert "estimate only" in capsys.readouterr().out
 
 
+def test_demo_policy_records_its_mp4_with_maniskill_record_episode(tmp_path: Path) -> None:
+    """The opened episode's video is ManiSkill's RecordEpisode output, named after the demo's tag: the
+    reset frame, then every other control step at 10 fps (real time)."""
+    import imageio.v2 as imageio
+
+    from capt_env.commands.demo_policy import VIDEO_FPS, open_with_capt
+    from perception.checkpoints import default_checkpoint
+
+    row = open_with_capt("laptop", default_checkpoint("laptop"), 0, tmp_path, "laptop_episode0", max_steps=6)
+    assert row["steps"] == 6 and row["mp4"] == str(tmp_path / "laptop_episode0.mp4")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["laptop_episode0.mp4"]  # no trajectory files
+    reader = imageio.get_reader(row["mp4"])
+    assert reader.count_frames() == 4 and reader.get_meta_data()["fps"] == VIDEO_FPS == 10
+    reader.close()
+
+
 def test_estimate_errors_on_constructed_estimates() -> None:
     import numpy as np
 
