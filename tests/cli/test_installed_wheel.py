@@ -44,10 +44,12 @@ def _run(venv: Path, *args: str, cwd: Path) -> subprocess.CompletedProcess:
 
 def test_the_wheel_runs_outside_the_repository(installed: Path, tmp_path: Path) -> None:
     where = _run(installed, "doctor", cwd=tmp_path)
-    code = "import capt_env; print(capt_env.__file__)"
+    code = "import capt_common.typed_yaml, capt_env; print(capt_env.__file__); print(capt_common.__file__)"
     probe = subprocess.run([str(installed / "bin" / "python"), "-c", code], cwd=tmp_path, capture_output=True,
                            text=True, timeout=60)
-    assert probe.stdout.startswith(str(installed)), probe.stdout  # the installed copy, not the checkout
+    paths = probe.stdout.split()
+    assert len(paths) == 2, probe.stderr[-2000:]
+    assert all(p.startswith(str(installed)) for p in paths), paths  # the installed copies, not the checkout
     assert where.returncode == 0, where.stderr[-2000:]
     train_help = _run(installed, "train", "--help", cwd=tmp_path)
     assert train_help.returncode == 0 and "(default: capt)" in " ".join(train_help.stdout.split())
