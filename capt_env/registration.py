@@ -10,7 +10,8 @@ CabinetDoor) plus a generic one taking ``task={"category": ...}`` or ``task={"ob
   wrappers (classes or callables ``env -> env``) to the ManiSkill env before it is unbatched, e.g.
   ``mani_skill.utils.wrappers.FlattenRGBDObservationWrapper``.
 - ``CaptOpen<Cat>-ms-v0`` / ``CaptOpenArticulated-ms-v0``: the ManiSkill env itself (batched torch
-  tensors; ``num_envs > 1`` and ``sim_backend="physx_cuda"`` on a GPU).
+  tensors; ``num_envs > 1`` and ``sim_backend="physx_cuda"`` on a GPU, a different instance of the
+  category in each sub-scene).
 
 ``gymnasium.make("capt_env:CaptOpenLaptop-v0")`` imports the package and registers the ids, so
 other projects need no import of their own (Gymnasium 1.x reads no plugin entry points);

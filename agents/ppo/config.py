@@ -107,8 +107,8 @@ class PPOTrainConfig:
     :class:`capt_env.wrappers.batched_oracle_observation.BatchedOracleObservation` and stepped by
     :class:`agents.ppo.maniskill_vec_env.ManiSkillVecEnv`. It takes the ``oracle`` or
     ``noisy_oracle`` source, ``obs_mode: state`` and no residual (the scripted opener runs per env
-    in numpy). Its sub-scenes share one object instance; every ``reconfigure_every_steps`` batch
-    steps (0: never) all episodes are cut and a new train-split instance is built.
+    in numpy). Each sub-scene holds its own train-split instance; every ``reconfigure_every_steps``
+    batch steps (0: never) all episodes are cut and every sub-scene gets a new instance.
     """
 
     category: str = "laptop"

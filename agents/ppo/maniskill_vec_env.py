@@ -11,11 +11,12 @@ the task's ``success`` at its last step (what ``agents.ppo.train.episode_stats``
 With ``continue_after_success`` an episode does not end at the task's success but runs to the step
 limit (``agents.ppo.train.ContinueAfterSuccess`` says why).
 
-With more than one sub-scene every sub-scene holds the same object instance (the task builds one
-object for the whole batch), and a partial reset keeps it. ``reconfigure_every`` > 0 cuts every
-episode (as truncated, so PPO bootstraps them) once that many steps have passed since the last
-reconfiguration, and resets all sub-scenes with ``reconfigure=True``: a new instance from the split
-for the whole batch.
+With more than one sub-scene each sub-scene holds its own object instance, drawn from the task's
+split by that sub-scene's episode RNG (:mod:`capt_env.tasks.object_batch`), and a partial reset
+keeps it; a seeded ``reset`` (after ``seed(s)``, as SB3 does) rebuilds every sub-scene, so the
+instances follow the seeds. ``reconfigure_every`` > 0 cuts every episode (as truncated, so PPO
+bootstraps them) once that many steps have passed since the last reconfiguration, and resets all
+sub-scenes with ``reconfigure=True``: a new instance for every sub-scene.
 """
 
 from __future__ import annotations
@@ -57,7 +58,9 @@ class ManiSkillVecEnv(VecEnv):
     def reset(self) -> VecEnvObs:
         seeds = [s for s in self._seeds if s is not None]
         seed = [int(s) for s in self._seeds] if len(seeds) == self.num_envs else None
-        obs, _ = self.env.reset(seed=seed)
+        # seeded: rebuild, so that each sub-scene's instance follows its seed (the env was built with
+        # ManiSkill's fixed construction seeds)
+        obs, _ = self.env.reset(seed=seed, options={"reconfigure": True} if seed is not None else None)
         self._reset_seeds()
         self._since_reconfigure = 0
         self._returns.zero_()

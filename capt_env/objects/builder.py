@@ -41,6 +41,7 @@ def build_articulated_object(
     fix_root: bool = True,
     scale: float = 1.0,
     pose: sapien.Pose | None = None,
+    scene_idxs: list[int] | None = None,
 ) -> Articulation:
     """Build ``spec`` into ``scene`` (a ``ManiSkillScene``) and return the articulation.
 
@@ -49,6 +50,8 @@ def build_articulated_object(
     :param scale: uniform scale of all lengths (boxes, joint origins, prismatic limits); densities
         are kept, so masses scale with scale**3.
     :param pose: root pose in the world (default: identity, so the object frame is the world frame).
+    :param scene_idxs: the sub-scenes to build it in (default: every sub-scene); ManiSkill's way to
+        put a different object in each sub-scene (one build per sub-scene, then ``Articulation.merge``).
     """
     if scale <= 0:
         raise ValueError(f"scale must be > 0, got {scale}")
@@ -58,6 +61,8 @@ def build_articulated_object(
 
     builder = scene.create_articulation_builder()
     builder.set_name(name)
+    if scene_idxs is not None:
+        builder.set_scene_idxs(list(scene_idxs))
     builder.initial_pose = pose if pose is not None else sapien.Pose()
     link_builders: dict[str, Any] = {}
     joint_of_child = {j.child: j for j in spec.joints}
@@ -99,7 +104,7 @@ def build_articulated_object(
     art = builder.build(name=name, fix_root_link=fix_root)
     if not scene.gpu_sim_enabled:
         # CPU: place the links now, so link and joint poses are valid before the first step
-        art.set_root_pose(builder.initial_pose)
+        art.set_root_pose(pose if pose is not None else sapien.Pose())  # a sapien.Pose: every sub-scene
     for joint in spec.joints:
         sim_joint = art.joints_map[joint.name]
         sim_joint.set_friction(joint.friction)

@@ -4,7 +4,8 @@ Everything here is computed once per reconfiguration: the movable joints and the
 limit of each is closed (so that task joint states are 0 closed and grow while opening), which
 joint to open, where to grasp it, the object's bounds in its own frame at the closed state, the yaw
 that turns its front to the robot, and the lookup table from simulator segmentation ids to part
-labels.
+labels. A :class:`LoadedObject` is one articulation, built into every sub-scene or into one
+(``scene_idxs``); :mod:`capt_env.tasks.object_batch` holds one per sub-scene.
 """
 
 from __future__ import annotations
@@ -77,14 +78,19 @@ class LoadedObject:
         return self.joints[self.target_joint].child_link
 
 
-def choose_instance(cfg: TaskConfig, rng: np.random.RandomState, instance_id: int | None) -> int:
-    """The procedural instance for this reconfiguration: ``instance_id`` if given, else a seeded draw."""
+def allowed_instances(cfg: TaskConfig) -> list[int]:
+    """The procedural instance ids the task draws from: ``instance_ids``, else the ``split``'s ids."""
     if cfg.instance_ids is not None:
-        allowed = list(cfg.instance_ids)
-    elif cfg.split == "all":
-        allowed = [i for s in ("train", "val", "test") for i in split_instance_ids(cfg.category, s)]
-    else:
-        allowed = split_instance_ids(cfg.category, cfg.split)
+        return list(cfg.instance_ids)
+    if cfg.split == "all":
+        return [i for s in ("train", "val", "test") for i in split_instance_ids(cfg.category, s)]
+    return split_instance_ids(cfg.category, cfg.split)
+
+
+def choose_instance(cfg: TaskConfig, rng: np.random.RandomState, instance_id: int | None) -> int:
+    """The procedural instance for this reconfiguration: ``instance_id`` if given, else a seeded draw
+    (one ``rng.randint`` call)."""
+    allowed = allowed_instances(cfg)
     if instance_id is not None:
         if instance_id not in allowed:
             raise ValueError(
@@ -101,7 +107,7 @@ def load_object(
     """Build the configured object into ``scene`` (root at the origin, every joint closed) and
     describe it."""
     if cfg.category is not None:
-        return _load_procedural(scene, cfg, rng, instance_id)
+        return load_procedural(scene, cfg, choose_instance(cfg, rng, instance_id))
     if instance_id is not None:
         raise ValueError("instance_id applies to procedural categories, not to a user object file")
     return _load_user_file(scene, cfg)
@@ -120,18 +126,21 @@ def _joint_table(art: Articulation) -> JointTable:
     return joints, names, type_ids, limits, child_parts
 
 
-def _load_procedural(scene: Any, cfg: TaskConfig, rng: np.random.RandomState,
-                     instance_id: int | None) -> LoadedObject:
-    iid = choose_instance(cfg, rng, instance_id)
+def load_procedural(scene: Any, cfg: TaskConfig, instance_id: int, name: str = "object",
+                    scene_idxs: list[int] | None = None) -> LoadedObject:
+    """Build instance ``instance_id`` of ``cfg.category`` as articulation ``name`` (unique in the
+    scene) in the sub-scenes ``scene_idxs`` (default: all) and describe it."""
+    iid = int(instance_id)
     spec = make_object(cfg.category, iid)
-    art = build_articulated_object(scene, spec, name="object", fix_root=True, scale=cfg.scale)
+    art = build_articulated_object(scene, spec, name=name, fix_root=True, scale=cfg.scale,
+                                   scene_idxs=scene_idxs)
     joints, names, type_ids, sim_limits, child_parts = _joint_table(art)
     links = list(art.links)
     link_names = [link.name for link in links]
     lo, hi = spec.aabb()
     # Procedural joints are closed at their lower limit and open towards the upper one.
     return LoadedObject(
-        articulation=art, name="object", category=cfg.category, instance_id=iid, spec=spec,
+        articulation=art, name=name, category=cfg.category, instance_id=iid, spec=spec,
         joints=joints, joint_names=names, joint_type_ids=type_ids,
         limits=_task_limits(sim_limits), closed_qpos=sim_limits[:, 0].copy(), open_sign=np.ones(len(joints)),
         child_parts=child_parts, target_joint=_find_joint(names, spec.target_joint),

@@ -7,7 +7,9 @@ the door/lid about its hinge, or pull the drawer.
 
 **Randomisations** (per episode, from the episode seed; see :class:`TaskConfig`):
 - the object instance (drawn from the configured split or id list; a new one each reconfiguration,
-  which by default happens every reset when ``num_envs == 1``);
+  which by default happens every reset when ``num_envs == 1``); with ``num_envs > 1`` each sub-scene
+  draws its own instance from its episode RNG (:mod:`capt_env.tasks.object_batch`; a user file is
+  the same file in every sub-scene);
 - the object's position on the table (+-``object_xy_noise``) and yaw (+-``yaw_noise``);
 - the target joint's initial state (fraction ``target_init_fraction`` of its range) and the other
   joints' states (``other_init_fraction``);
@@ -25,10 +27,13 @@ the closed state, and its child link is at rest.
 ``d`` the gripper-to-grasp-point distance in metres (held at 1 once the part has moved),
 ``progress = clip(open_fraction / success_fraction, 0, 1)``. Normalised dense: the same / 5.
 
-**Ground truth.** ``info`` holds, for every movable joint of the object (batched, world frame):
-``joint_type`` (0 revolute, 1 prismatic), ``joint_axis`` (unit, +state opens), ``joint_pivot``
-(a point on the axis: the joint frame origin), ``joint_state`` (rad or m), ``joint_limits``,
-``joint_child_part``, plus ``target_joint``, ``open_fraction``, ``grasp_point``, ``success``.
+**Ground truth.** ``info`` holds, for every movable joint of each sub-scene's object (leading
+``num_envs`` dimension, then the joint slot; world frame): ``joint_type`` (0 revolute, 1 prismatic),
+``joint_axis`` (unit, +state opens), ``joint_pivot`` (a point on the axis: the joint frame origin),
+``joint_state`` (rad or m), ``joint_limits``, ``joint_child_part``, ``joint_mask`` (which slots hold
+a joint: sub-scenes whose instances have fewer joints than the batch's most are padded, see
+:mod:`capt_env.tasks.object_batch`), plus per sub-scene ``target_joint`` (a slot index),
+``open_fraction``, ``grasp_point``, ``success``.
 In ``pointcloud`` mode the observation's ``pointcloud`` dict also carries ``part_label``: for each
 point the object part it lies on (0 = everything fixed to the base, ``k + 1`` = the part movable
 joint ``k`` moves, links joined by fixed joints counted as one part), or -1 for anything that is not
@@ -57,7 +62,8 @@ from capt_common.typed_yaml import from_dict
 from capt_env.registration import GENERIC_ID
 from capt_env.rendering import translate_render_error
 from capt_env.tasks.config import TaskConfig, read_task_yaml
-from capt_env.tasks.object_loading import LoadedObject, load_object
+from capt_env.tasks.object_batch import ObjectBatch, load_objects
+from capt_env.tasks.object_loading import LoadedObject
 
 JOINT_TYPE_IDS = {"revolute": 0, "prismatic": 1}
 # End-effector deltas: [-1, 1] maps to +-0.1 m / +-0.1 rad per 20 Hz control step (ManiSkill 3.0.1
@@ -123,7 +129,7 @@ class OpenArticulatedEnv(BaseEnv):
             base[key] = value
         self.task_config: TaskConfig = from_dict(TaskConfig, base, where=where)
         self.robot_init_qpos_noise = robot_init_qpos_noise
-        self.object: LoadedObject | None = None
+        self.object_batch: ObjectBatch | None = None  # the object of every sub-scene, set in _load_scene
         if reconfiguration_freq is None:
             reconfiguration_freq = 1 if num_envs == 1 else 0
         kwargs.setdefault("control_mode", DEFAULT_CONTROL_MODE)
@@ -181,114 +187,127 @@ class OpenArticulatedEnv(BaseEnv):
         self.table_scene = TableSceneBuilder(self, robot_init_qpos_noise=self.robot_init_qpos_noise)
         self.table_scene.build()
         instance_id = options.get("instance_id") if options else None
-        self.object = load_object(self.scene, self.task_config, self._episode_rng, instance_id)
+        self.object_batch = load_objects(self.scene, self.task_config, self._batched_episode_rng.rngs,
+                                         instance_id)
+
+    @property
+    def object(self) -> LoadedObject | None:
+        """The object every sub-scene holds (None before the scene is built).
+
+        :raises RuntimeError: if the sub-scenes hold different instances (``num_envs > 1``): use
+            ``object_batch`` (``object_batch.objects[i]`` is sub-scene i's).
+        """
+        batch = self.object_batch
+        if batch is None:
+            return None
+        if not batch.shared:
+            raise RuntimeError("the sub-scenes hold different objects (instances "
+                               f"{batch.instance_ids}); use env.object_batch")
+        return batch.objects[0]
 
     @property
     def articulation(self) -> Articulation:
-        """The object being opened (ManiSkill articulation, batched over sub-scenes)."""
-        assert self.object is not None
-        return self.object.articulation
+        """The object being opened (ManiSkill articulation, batched over sub-scenes: a merged view
+        when they hold different instances, qpos padded to the most joints)."""
+        assert self.object_batch is not None
+        return self.object_batch.articulation
 
     # ---------------------------------------------------------------- episode
     def _initialize_episode(self, env_idx: torch.Tensor, options: dict) -> None:
         cfg = self.task_config
-        obj = self.object
-        b = len(env_idx)
+        batch = self.object_batch
+        rows = env_idx.cpu().numpy()
+        b, dof = len(rows), batch.max_dof
         with torch.device(self.device):
             self.table_scene.initialize(env_idx)
             rng = self._batched_episode_rng[env_idx]
             noise_xy = np.stack([rng.uniform(-n, n) for n in cfg.object_xy_noise], axis=-1)
-            yaw = obj.front_yaw + rng.uniform(-cfg.yaw_noise, cfg.yaw_noise)
-            placement = self._placement(torch.as_tensor(noise_xy, dtype=torch.float32),
+            yaw = batch.front_yaw[rows] + rng.uniform(-cfg.yaw_noise, cfg.yaw_noise)
+            placement = self._placement(rows, torch.as_tensor(noise_xy, dtype=torch.float32),
                                         torch.as_tensor(yaw, dtype=torch.float32))
             self.articulation.set_pose(Pose.create_from_pq(p=placement.root_p, q=placement.root_q))
 
-            span = obj.limits[:, 1] - obj.limits[:, 0]
-            frac = np.stack([rng.uniform(*cfg.other_init_fraction) for _ in range(obj.dof)], axis=-1)
-            frac[:, obj.target_joint] = rng.uniform(*cfg.target_init_fraction)
-            qpos = obj.sim_qpos(frac.reshape(b, obj.dof) * span)
+            span = batch.limits[rows, :, 1] - batch.limits[rows, :, 0]
+            frac = np.stack([rng.uniform(*cfg.other_init_fraction) for _ in range(dof)], axis=-1)
+            frac[np.arange(b), batch.target_joint[rows]] = rng.uniform(*cfg.target_init_fraction)
+            qpos = batch.sim_qpos(frac.reshape(b, dof) * span, rows)
             self.articulation.set_qpos(torch.as_tensor(qpos, dtype=torch.float32))
-            self.articulation.set_qvel(torch.zeros((b, obj.dof)))
-            self._aim_cameras(placement, float(np.asarray(yaw).reshape(-1)[0]), self._episode_rng)
+            self.articulation.set_qvel(torch.zeros((b, dof)))
+            self._aim_cameras(rows, placement, np.asarray(yaw, dtype=np.float64).reshape(b))
 
-    def _placement(self, noise_xy: torch.Tensor, yaw: torch.Tensor) -> _Placement:
-        """Root pose putting the object's bounding-box centre at ``placement_xy() + noise`` on the table."""
-        obj = self.object
-        lo, hi = obj.aabb
+    def _placement(self, rows: np.ndarray, noise_xy: torch.Tensor, yaw: torch.Tensor) -> _Placement:
+        """Root poses putting the bounding-box centre of the objects of sub-scenes ``rows`` (b,) at
+        ``placement_xy() + noise_xy`` (b, 2) on the table, turned by ``yaw`` (b,) radians."""
+        lo, hi = self.object_batch.aabb[rows, 0], self.object_batch.aabb[rows, 1]  # (b, 3) object frame
         centre_local = torch.as_tensor((lo + hi) / 2, dtype=torch.float32)
         target_xy = torch.as_tensor(self.task_config.placement_xy(), dtype=torch.float32) + noise_xy
         c, s = torch.cos(yaw), torch.sin(yaw)
-        rot_cx = c * centre_local[0] - s * centre_local[1]
-        rot_cy = s * centre_local[0] + c * centre_local[1]
-        z = torch.full_like(yaw, float(-lo[2]) + 1e-3)
+        rot_cx = c * centre_local[:, 0] - s * centre_local[:, 1]
+        rot_cy = s * centre_local[:, 0] + c * centre_local[:, 1]
+        z = torch.as_tensor(-lo[:, 2] + 1e-3, dtype=torch.float32)
         root_p = torch.stack([target_xy[:, 0] - rot_cx, target_xy[:, 1] - rot_cy, z], dim=-1)
-        centre = torch.stack([target_xy[:, 0], target_xy[:, 1], z + float(centre_local[2])], dim=-1)
+        centre = torch.stack([target_xy[:, 0], target_xy[:, 1], z + centre_local[:, 2]], dim=-1)
         return _Placement(root_p=root_p, root_q=_yaw_quat(yaw), centre=centre)
 
-    def _aim_cameras(self, placement: _Placement, yaw: float, rng: Any) -> None:
-        """Point every camera at the object's centre (env 0's pose is used for all sub-scenes).
+    def _aim_cameras(self, rows: np.ndarray, placement: _Placement, yaw: np.ndarray) -> None:
+        """Point every camera of sub-scenes ``rows`` (b,) at their object's centre, drawing each
+        sub-scene's eye from its own episode RNG.
 
-        ``yaw`` is env 0's object yaw; the object's front then faces world direction ``yaw - front_yaw``
+        ``yaw`` (b,) is each object's yaw; its front then faces world direction ``yaw - front_yaw``
         rotated from +x, i.e. towards the robot (-x) up to the yaw noise.
         """
-        target = placement.centre[0].cpu().numpy().astype(np.float64)
-        front = yaw - self.object.front_yaw + np.pi  # world azimuth of the object's front normal
-        for cam in self.task_config.cameras:
-            if cam.name not in self._sensors:
-                continue
-            if cam.random_view:
-                dist = float(rng.uniform(*cam.distance))
-                az = front + float(rng.uniform(*cam.azimuth))
-                el = float(rng.uniform(*cam.elevation))
-                offset = dist * np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
-            else:
-                offset = np.asarray(cam.eye, dtype=np.float64)
-                offset = offset + np.asarray(rng.uniform(-cam.jitter, cam.jitter, size=3)).reshape(3)
-            pose = sapien_utils.look_at(eye=(target + offset).tolist(), target=target.tolist())
-            self._sensors[cam.name].camera.set_local_pose(pose.sp)
+        centres = placement.centre.cpu().numpy().astype(np.float64)
+        for j, i in enumerate(int(r) for r in rows):
+            rng, target = self._batched_episode_rng[i], centres[j]
+            front = float(yaw[j]) - self.object_batch.front_yaw[i] + np.pi  # azimuth of the front normal
+            for cam in self.task_config.cameras:
+                if cam.name not in self._sensors:
+                    continue
+                if cam.random_view:
+                    dist = float(rng.uniform(*cam.distance))
+                    az = front + float(rng.uniform(*cam.azimuth))
+                    el = float(rng.uniform(*cam.elevation))
+                    offset = dist * np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+                else:
+                    offset = np.asarray(cam.eye, dtype=np.float64)
+                    offset = offset + np.asarray(rng.uniform(-cam.jitter, cam.jitter, size=3)).reshape(3)
+                pose = sapien_utils.look_at(eye=(target + offset).tolist(), target=target.tolist())
+                _set_camera_pose(self._sensors[cam.name].camera, i, pose.sp)
 
     # ------------------------------------------------------------ evaluation
     def joint_ground_truth(self) -> dict[str, torch.Tensor]:
-        """World-frame ground truth of every movable joint, batched: see the module docstring."""
-        obj = self.object
-        axes, pivots = [], []
-        for joint, sign in zip(obj.joints, obj.open_sign, strict=True):
-            mat = joint.get_global_pose().to_transformation_matrix()  # (b, 4, 4)
-            axes.append(float(sign) * mat[..., :3, 0])  # turned so that a growing state opens
-            pivots.append(mat[..., :3, 3])
-        b = self.num_envs
+        """World-frame ground truth of every joint slot of every sub-scene, (num_envs, J, ...): see
+        the module docstring."""
+        batch = self.object_batch
+        axes, pivots = batch.joint_frames()
         return {
-            "joint_type": torch.as_tensor(obj.joint_type_ids, device=self.device).expand(b, -1),
-            "joint_axis": torch.stack(axes, dim=1),
-            "joint_pivot": torch.stack(pivots, dim=1),
-            "joint_state": obj.task_state(self.articulation.qpos),
-            "joint_limits": torch.as_tensor(obj.limits, dtype=torch.float32, device=self.device)
-            .expand(b, -1, -1),
-            "joint_child_part": torch.as_tensor(obj.child_parts, device=self.device).expand(b, -1),
+            "joint_type": batch.tensor("joint_type").clone(),
+            "joint_axis": axes,
+            "joint_pivot": pivots,
+            "joint_state": batch.task_state(self.articulation.qpos),
+            "joint_limits": batch.tensor("limits", torch.float32).clone(),
+            "joint_child_part": batch.tensor("child_parts").clone(),
+            "joint_mask": batch.tensor("joint_mask").clone(),
         }
 
     def grasp_point(self) -> torch.Tensor:
-        """(b, 3) world-frame grasp point on the target part (handle centre or far edge), metres."""
-        obj = self.object
-        mat = obj.grasp_link.pose.to_transformation_matrix()
-        local = torch.as_tensor(obj.grasp_local, dtype=torch.float32, device=self.device)
-        return (mat[..., :3, :3] @ local) + mat[..., :3, 3]
+        """(num_envs, 3) world-frame grasp point on each target part (handle centre or far edge), metres."""
+        return self.object_batch.grasp_point()
 
     def evaluate(self) -> dict[str, torch.Tensor]:
         cfg = self.task_config
-        obj = self.object
+        batch = self.object_batch
         gt = self.joint_ground_truth()
-        k = obj.target_joint
-        lo, hi = float(obj.limits[k, 0]), float(obj.limits[k, 1])
-        open_fraction = (gt["joint_state"][:, k] - lo) / (hi - lo)
-        child = obj.target_child_link
+        lo, hi = batch.target_values(gt["joint_limits"]).unbind(-1)  # (num_envs,) each
+        open_fraction = (batch.target_values(gt["joint_state"]) - lo) / (hi - lo)
+        child = batch.target_link
         at_rest = (torch.linalg.norm(child.linear_velocity, dim=-1) <= cfg.rest_linear_speed) & (
             torch.linalg.norm(child.angular_velocity, dim=-1) <= cfg.rest_angular_speed
         )
         opened = open_fraction >= cfg.success_fraction
         return {
             **gt,
-            "target_joint": torch.full((self.num_envs,), k, device=self.device, dtype=torch.long),
+            "target_joint": batch.tensor("target_joint").clone(),
             "open_fraction": open_fraction,
             "grasp_point": self.grasp_point(),
             "opened": opened,
@@ -301,7 +320,8 @@ class OpenArticulatedEnv(BaseEnv):
             obs.update(
                 grasp_point=info["grasp_point"],
                 tcp_to_grasp=info["grasp_point"] - self.agent.tcp.pose.p,
-                target_qpos=self.object.task_state(self.articulation.qpos)[:, [self.object.target_joint]],
+                target_qpos=self.object_batch.target_values(
+                    self.object_batch.task_state(self.articulation.qpos)).unsqueeze(-1),
                 open_fraction=info["open_fraction"].unsqueeze(-1),
             )
         return obs
@@ -334,8 +354,9 @@ class OpenArticulatedEnv(BaseEnv):
         return obs
 
     def part_labels_from_segmentation(self, seg: torch.Tensor) -> torch.Tensor:
-        """Map simulator per-scene segmentation ids (b, N) to object part labels (b, N); -1 = not object."""
-        lut = self.object.segmentation_lut.to(seg.device)
+        """Map simulator per-scene segmentation ids (num_envs, N) to object part labels (num_envs, N),
+        each sub-scene by its own object's table; -1 = not object."""
+        lut = self.object_batch.segmentation_lut.to(seg.device)
         clipped = seg.clamp(0, lut.shape[-1] - 1)
         labels = torch.gather(lut.expand(seg.shape[0], -1), 1, clipped)
         return torch.where(seg < lut.shape[-1], labels, torch.full_like(labels, -1))
@@ -349,6 +370,15 @@ class OpenArticulatedEnv(BaseEnv):
 
     def compute_normalized_dense_reward(self, obs: Any, action: torch.Tensor, info: dict) -> torch.Tensor:
         return self.compute_dense_reward(obs=obs, action=action, info=info) / 5.0
+
+
+def _set_camera_pose(camera: Any, scene_idx: int, pose: sapien.Pose) -> None:
+    """Set the pose of sub-scene ``scene_idx``'s copy of an unmounted ManiSkill camera
+    (``RenderCamera``; its own ``set_local_pose`` sets every sub-scene's) and drop the poses and
+    matrices it caches from them."""
+    camera._render_cameras[scene_idx].set_local_pose(pose)
+    camera._cached_local_pose = None
+    camera._cached_model_matrix = None
 
 
 _TASK_FIELDS = {f.name for f in dataclasses.fields(TaskConfig)}

@@ -6,8 +6,10 @@ the ground-truth sources, so PPO can train on ManiSkill's GPU simulation (``Capt
 env's device, one row per sub-scene, in the flat layout of :mod:`capt_env.wrappers.joint_observation`
 ((num_envs, 38) float32, world frame, metres, radians).
 
-- ``oracle``: the target joint's ground truth from the task's ``info``, the pivot made canonical
-  (the axis point closest to the grasp point), confidence 1.
+- ``oracle``: each sub-scene's target joint's ground truth from the task's ``info``, the pivot made
+  canonical (the axis point closest to the grasp point), confidence 1. With ``num_envs > 1`` the
+  sub-scenes hold different instances (:mod:`capt_env.tasks.object_batch`), so the target joint is
+  read per row (``info["target_joint"]``, a slot of the padded joint arrays).
 - ``noisy_oracle``: the same plus :class:`~capt_env.wrappers.config.NoiseConfig` noise of the same
   distributions as :class:`~capt_env.wrappers.perception_sources.NoisyOracleSource` (``gaussian``
   redrawn at every look; ``fixed_offset`` of exact sizes drawn at a sub-scene's reset and held for

@@ -137,6 +137,15 @@ def test_vec_env_success_does_not_end_training_episodes_and_reconfigure_cuts_all
         ManiSkillVecEnv(BatchedOracleObservation(fake), reconfigure_every=-1)
 
 
+def test_a_seeded_vec_env_reset_rebuilds_so_instances_follow_the_seed():
+    fake = FakeBatchedEnv([4, 4])
+    venv = ManiSkillVecEnv(BatchedOracleObservation(fake, {"source": "oracle"}))
+    venv.reset()
+    venv.seed(7)
+    venv.reset()
+    assert fake.resets == [([0, 1], False), ([0, 1], True)]
+
+
 def test_batched_wrapper_rejects_what_it_cannot_do():
     fake = FakeBatchedEnv([5])
     with pytest.raises(ConfigError, match="oracle"):
