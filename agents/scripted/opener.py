@@ -49,6 +49,10 @@ releases, retreats and is done; so has one that slips from the hand past ``prism
 A door that gravity opens (:func:`~agents.scripted.grasp_pose.falls_open`, an oven door) is not
 grasped again once the hand loses it past ``fall_open_done``; short of that, the open hand moves
 out of the door's sweep and waits while it falls, then is done or grasps again (``RETREAT``).
+
+Every phase change is recorded in ``phase_log`` (the step, the phase entered and why; a pull also
+records whether its fingers held the part), from which
+:func:`agents.scripted.failure_cause.failure_cause` names why a failed episode failed.
 """
 
 from __future__ import annotations
@@ -146,6 +150,10 @@ class ScriptedOpener:
         """Start a new episode."""
         self.phase = Phase.PREGRASP
         self.phase_steps = 0
+        self.steps = 0  # act_on calls this episode (control steps)
+        # one entry per phase entered: {"step", "phase", "why"}, and a pull's "grip" (see _grip)
+        self.phase_log: list[dict[str, Any]] = [{"step": 0, "phase": Phase.PREGRASP.value, "why": "start"}]
+        self._reach_why = ""  # how the last move ended: "reached", "timeout" or "blocked"
         self.regrasps = 0
         self._grasp_p: np.ndarray | None = None
         self._grasp_r: np.ndarray | None = None
@@ -190,9 +198,11 @@ class ScriptedOpener:
         return (np.clip(action, -1.0, 1.0).astype(np.float32), float(np.linalg.norm(p_des - p)),
                 float(np.linalg.norm(rotation_error(r_des, r))))
 
-    def _set(self, phase: Phase) -> None:
+    def _set(self, phase: Phase, why: str) -> None:
+        """Enter ``phase`` for the reason ``why`` (a word, recorded in ``phase_log``)."""
         if phase != Phase.APPROACH:
             self._watch = []
+        self.phase_log.append({"step": self.steps, "phase": phase.value, "why": why})
         self.phase = phase
         self.phase_steps = 0
         self._still = 0
@@ -236,8 +246,15 @@ class ScriptedOpener:
             abs(rerr - self._last_err[1]) > 0.01)
         self._still = 0 if moved or self.phase_steps <= 3 else self._still + 1
         self._last_p, self._last_err = p.copy(), (perr, rerr)
-        return (perr < self.cfg.pos_tolerance and rerr < self.cfg.rot_tolerance) or (
-            self.phase_steps >= self.cfg.move_timeout) or self._still >= self.cfg.blocked_steps
+        if perr < self.cfg.pos_tolerance and rerr < self.cfg.rot_tolerance:
+            self._reach_why = "reached"
+        elif self.phase_steps >= self.cfg.move_timeout:
+            self._reach_why = "timeout"
+        elif self._still >= self.cfg.blocked_steps:
+            self._reach_why = "blocked"
+        else:
+            return False
+        return True
 
     # ------------------------------------------------------------------- act
     def act(self, obs: np.ndarray | dict[str, np.ndarray], info: dict[str, Any] | None = None) -> np.ndarray:
@@ -261,6 +278,7 @@ class ScriptedOpener:
         p = np.asarray(tcp_pose[:3], dtype=np.float64)
         r = quat_to_matrix(tcp_pose[3:7])
         self.phase_steps += 1
+        self.steps += 1
         if self._motion is not None and est.joint_type == self._motion_type:
             est = self._with_motion_axis(est)  # every phase (re-grasps too) goes by the measured axis
 
@@ -272,7 +290,7 @@ class ScriptedOpener:
                 self._grasp_p = np.array(est.grasp_point, dtype=np.float64)
                 self._grasp_again, self._target_r = True, None
                 self._retreat_from, self._settle = p.copy(), []
-                self._set(Phase.RETREAT)
+                self._set(Phase.RETREAT, "falling_open")
                 return hold(GRIPPER_OPEN)
             if self.phase == Phase.PREGRASP:
                 self._pregrasp_steps += 1
@@ -316,11 +334,11 @@ class ScriptedOpener:
                 return action
             if self._reached(p, perr, rerr):
                 if self.phase == Phase.PREGRASP:
-                    self._set(Phase.APPROACH)
+                    self._set(Phase.APPROACH, self._reach_why)
                 elif lift is not None:  # the closed fingertips are under the lid: push it open
-                    self._start_pull(p, r, est)
+                    self._start_pull(p, r, est, "under")
                 else:
-                    self._set(Phase.CLOSE)
+                    self._set(Phase.CLOSE, self._reach_why)
             return action
 
         if self.phase == Phase.CLOSE:
@@ -331,7 +349,7 @@ class ScriptedOpener:
                     # the fingers closed on nothing across the lid's lip (wider than the open
                     # fingers): back off, then lift the lid from below
                     self._lift = self._grasp_again = True
-                    self._set(Phase.RELEASE)
+                    self._set(Phase.RELEASE, "empty")
                 elif (not self._lid and cfg.regrasp_other_fingers and finger_gap is not None
                         and finger_gap < cfg.hold_gap and self.regrasps < cfg.max_regrasps):
                     # the fingers closed on nothing: the arm stopped short of the handle (a low handle
@@ -339,9 +357,10 @@ class ScriptedOpener:
                     # and grasp again with the fingers the other way round
                     self.regrasps += 1
                     self._grasp_again = self._other_fingers = True
-                    self._set(Phase.RELEASE)
+                    self._set(Phase.RELEASE, "empty")
                 else:
-                    self._start_pull(p, r, est)
+                    empty = finger_gap is not None and finger_gap < cfg.hold_gap
+                    self._start_pull(p, r, est, "empty" if empty else "closed")
             return action
 
         if self.phase == Phase.PULL:
@@ -351,7 +370,7 @@ class ScriptedOpener:
             action = hold(GRIPPER_OPEN)
             if self.phase_steps >= cfg.release_steps:
                 self._retreat_from = p.copy()
-                self._set(Phase.RETREAT)
+                self._set(Phase.RETREAT, "released")
             return action
 
         if self.phase == Phase.RETREAT:
@@ -368,9 +387,9 @@ class ScriptedOpener:
                 elif self._grasp_again:
                     self._grasp_again = False
                     self._target_r = None
-                    self._set(Phase.PREGRASP)
+                    self._set(Phase.PREGRASP, "regrasp")
                 else:
-                    self._set(Phase.DONE)
+                    self._set(Phase.DONE, "retreated")
             return action
 
         return hold(GRIPPER_OPEN)
@@ -418,7 +437,7 @@ class ScriptedOpener:
             return other
         return nearer
 
-    def _start_pull(self, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate) -> None:
+    def _start_pull(self, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate, why: str) -> None:
         self._grasp_p, self._grasp_r, self._grasp_state = p.copy(), r.copy(), est.state
         self._grasp_u = unit(est.direction)
         self._falls = falls_open(est, self.cfg)
@@ -427,7 +446,9 @@ class ScriptedOpener:
         self._held = [p.copy()]
         self._hinge_fit = None
         self._slip_count = 0
-        self._set(Phase.PULL)
+        self._set(Phase.PULL, why)
+        # a hand lifting from below holds with closed fingers; unknown gaps count as holding
+        self.phase_log[-1]["grip"] = "held" if self._lift else "none"
 
     def _braked(self) -> bool:
         """Whether the hand, pulling at a cruising speed (median step of this pull, at least
@@ -563,10 +584,25 @@ class ScriptedOpener:
         again, self._grasp_again = self._grasp_again and est.state < cfg.fall_open_done, False
         if again:
             self._target_r = None
-            self._set(Phase.PREGRASP)
+            self._set(Phase.PREGRASP, "regrasp")
         else:
-            self._set(Phase.DONE)
+            self._set(Phase.DONE, "settled")
         return action
+
+    def _grip(self, holding: bool, unknown: bool) -> None:
+        """Record in this pull's ``phase_log`` entry whether the fingers hold the part: its
+        ``"grip"`` is ``"none"`` until the finger gap first reads at least ``hold_gap`` (``holding``),
+        then ``"held"``, and ``"lost"`` once the fingers have closed on nothing after holding (or
+        the slip check fires on a hand lifting from below, whose closed fingers tell no gap). Without
+        a gap (``unknown``) a pull counts as held."""
+        entry = self.phase_log[-1]
+        if unknown:
+            if entry.get("grip") == "none":
+                entry["grip"] = "held"
+        elif holding:
+            entry["grip"] = "held"
+        elif entry.get("grip") == "held" and not self._lift:
+            entry["grip"] = "lost"
 
     def _pull(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
               finger_gap: float | None = None, arm_qpos: np.ndarray | None = None) -> np.ndarray:
@@ -605,6 +641,7 @@ class ScriptedOpener:
             progress = (swept_angle(u, pivot, before, p) if revolute else float((p - before) @ u))
             stalled = progress < min_progress
         holding = finger_gap is not None and finger_gap >= cfg.hold_gap
+        self._grip(holding, finger_gap is None)
         falls = self._lets_fall()
         if state >= target or stalled or at_limit:
             # short of the target the grip slipped or the arm ran out of range: grasp again from here
@@ -626,32 +663,34 @@ class ScriptedOpener:
                 # the arm ran out of range with this finger order: the other one turns the wrist
                 # the other way
                 self._other_fingers = True
-            self._set(Phase.RELEASE)
+            self._set(Phase.RELEASE, "target" if state >= target else "stall" if stalled else "limit")
             return hold(GRIPPER_CLOSE)
         away = p - np.asarray(est.grasp_point, dtype=np.float64)
         if self._lid and cfg.lid_slip_off_axis:  # a lid is revolute (part_kind)
             away = off_axis(away, u)  # along its hinge, a lid's far edge is all the same to the hand
         far = float(np.linalg.norm(away)) > cfg.slip_distance and not holding
         self._slip_count = self._slip_count + 1 if far else 0
+        if self._slip_count >= cfg.slip_steps and self.phase_log[-1].get("grip") == "held":
+            self.phase_log[-1]["grip"] = "lost"  # (a lift's closed fingers tell no gap)
         if self._slip_count >= cfg.slip_steps and falls and est.state >= cfg.settle_above:
             # off the handle of a door that falls open: let go, clear it and wait (see RETREAT)
             # instead of reaching for a handle on the move; past fall_open_done it is left open
             self._grasp_again = est.state < cfg.fall_open_done and self.regrasps < cfg.max_regrasps
             self.regrasps += int(self._grasp_again)
             self._let_go_state = float(est.state)
-            self._set(Phase.RELEASE)
+            self._set(Phase.RELEASE, "slip")
             return hold(GRIPPER_OPEN)
         if self._slip_count >= cfg.slip_steps and not revolute and 0.0 < cfg.prismatic_stop_above <= state:
             # off the handle of a drawer pulled far out: it ran to its end stop and the brake was
             # missed; reaching for the handle again would push the open drawer back in
             self._grasp_again = False
             self._let_go_state = state
-            self._set(Phase.RELEASE)
+            self._set(Phase.RELEASE, "slip")
             return hold(GRIPPER_OPEN)
         if self._slip_count >= cfg.slip_steps and self.regrasps < cfg.max_regrasps:
             self.regrasps += 1
             self._target_r = None
-            self._set(Phase.PREGRASP)
+            self._set(Phase.PREGRASP, "slip")
             return hold(GRIPPER_OPEN)
         if revolute:
             lifting = self._lid and self._lift

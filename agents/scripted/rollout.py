@@ -4,9 +4,10 @@ and reports success rates."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
+from agents.scripted.failure_cause import failure_cause
 from agents.scripted.opener import Phase
 from capt_env.wrappers.perception_wrapper import CaptObservationWrapper
 
@@ -14,7 +15,10 @@ from capt_env.wrappers.perception_wrapper import CaptObservationWrapper
 @dataclass(frozen=True)
 class EpisodeResult:
     """One episode: the seed, instance, success (task's criterion at the end), final open fraction,
-    steps taken, and the opener's last phase."""
+    steps taken, the opener's last phase, its phase log (``ScriptedOpener.phase_log``: one
+    ``{"step", "phase", "why"}`` per phase entered, a pull's with its ``"grip"``) and the failure cause
+    named from it (:func:`~agents.scripted.failure_cause.failure_cause`; None for a success or a
+    policy without a phase log)."""
 
     seed: int
     instance_id: int
@@ -22,6 +26,8 @@ class EpisodeResult:
     open_fraction: float
     steps: int
     phase: str
+    phase_log: list[dict[str, Any]] = field(default_factory=list)
+    cause: str | None = None
 
 
 def run_episode(env: CaptObservationWrapper, opener: Any, seed: int, max_steps: int = 200,
@@ -38,5 +44,8 @@ def run_episode(env: CaptObservationWrapper, opener: Any, seed: int, max_steps: 
         if done_for >= settle_steps or truncated:
             break
     obj = env.unwrapped.object
-    return EpisodeResult(seed, int(obj.instance_id), bool(info["success"]), float(info["open_fraction"]),
-                         steps, getattr(getattr(opener, "phase", None), "value", "policy"))
+    success = bool(info["success"])
+    log = [dict(entry) for entry in getattr(opener, "phase_log", [])]
+    return EpisodeResult(seed, int(obj.instance_id), success, float(info["open_fraction"]),
+                         steps, getattr(getattr(opener, "phase", None), "value", "policy"), log,
+                         failure_cause(log, success))

@@ -98,12 +98,29 @@ def success_cells(row: dict[str, Any]) -> str:
             f"{row['mean_steps']:.0f} | {len(row['episodes'])}")
 
 
+def cause_row(episodes: list[EpisodeResult]) -> dict[str, Any]:
+    """``{"failure_causes": {cause: count}}``: the failed episodes of ``episodes`` counted by the
+    cause named from the scripted opener's phase log (:mod:`agents.scripted.failure_cause`; empty for a
+    policy that keeps no phase log)."""
+    from agents.scripted.failure_cause import count_causes
+
+    causes = [e.cause for e in episodes]
+    return {"failure_causes": count_causes(causes) if any(c is not None for c in causes) else {}}
+
+
+def cause_cell(row: dict[str, Any]) -> str:
+    """The Markdown cell of a :func:`cause_row`: ``cause count`` for each cause that occurred,
+    comma-separated; ``-`` for none."""
+    counts = row["failure_causes"]
+    return ", ".join(f"{cause} {n}" for cause, n in counts.items() if n) or "-"
+
+
 def run(args: argparse.Namespace) -> int:
     from capt_env.commands.episode_runner import EpisodeJob, play_episodes
 
     header = ("| object | perception | model | success | 95% interval | mean opened | mean steps | "
-              "episodes |")
-    rows, lines = [], [header, "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+              "episodes | failures by cause |")
+    rows, lines = [], [header, "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     targets = object_targets(args)
     seeds = list(range(args.first_seed, args.first_seed + args.episodes))
     task = task_overrides(args.task)
@@ -138,9 +155,11 @@ def run(args: argparse.Namespace) -> int:
             used = Path(wrapper["checkpoint"]).stem if source == "capt" else (model and Path(model).stem)
             row = {"object": target.label, "category": target.category, "task": job.task,
                    "policy": args.policy, "model": model, "perception": source,
-                   "checkpoint": wrapper.get("checkpoint"), "like": like, **success_row(episodes)}
+                   "checkpoint": wrapper.get("checkpoint"), "like": like,
+                   **cause_row(episodes), **success_row(episodes)}
             rows.append(row)
-            lines.append(f"| {target.label} | {source} | {used or '-'} | {success_cells(row)} |")
+            lines.append(f"| {target.label} | {source} | {used or '-'} | {success_cells(row)} | "
+                         f"{cause_cell(row)} |")
     table = "\n".join(lines)
     print(table)
     if args.markdown:

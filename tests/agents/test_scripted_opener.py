@@ -58,7 +58,7 @@ def test_a_lip_the_fingers_closed_on_nothing_is_lifted_from_below() -> None:
     opener = ScriptedOpener(cfg)
     above = np.array([-0.1, 0.05, 0.05, 0.0, 1.0, 0.0, 0.0])  # TCP on the lip, pointing down (wxyz)
     opener.act_on(est, above)  # the first pre-grasp step sees a lid
-    opener._set(Phase.CLOSE)
+    opener._set(Phase.CLOSE, "reached")
     for _ in range(cfg.close_steps):
         opener.act_on(est, above, finger_gap=0.0)
     assert opener.phase == Phase.RELEASE and opener._lift  # backs off, then lifts from below
@@ -76,7 +76,7 @@ def test_a_lip_the_fingers_closed_on_nothing_is_lifted_from_below() -> None:
     # fingers that closed on the lip (a gap) pull as before
     opener = ScriptedOpener(cfg)
     opener.act_on(est, above)
-    opener._set(Phase.CLOSE)
+    opener._set(Phase.CLOSE, "reached")
     for _ in range(cfg.close_steps):
         opener.act_on(est, above, finger_gap=0.01)
     assert opener.phase == Phase.PULL and not opener._lift
@@ -93,7 +93,7 @@ def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_
         opener = ScriptedOpener(ScriptedOpenerConfig(lid_lift_inward=inward, lid_lift_lead=0.12,
                                                      max_step_m=1.0))
         opener._lid = opener._lift = True
-        opener._start_pull(start, np.eye(3), est)
+        opener._start_pull(start, np.eye(3), est, "closed")
         return opener._pull(est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
 
     plain, inward = commanded(0.0), commanded(0.02)
@@ -112,7 +112,7 @@ def _lid_pull_after(seen_offset: np.ndarray, cfg: ScriptedOpenerConfig) -> Scrip
     now = est.pivot + axis_angle_matrix(est.direction, 0.5) @ (start - est.pivot)
     opener = ScriptedOpener(cfg)
     opener._lid = opener._lift = True
-    opener._start_pull(start, np.eye(3), est)
+    opener._start_pull(start, np.eye(3), est, "closed")
     seen = JointAxisEstimate("revolute", est.direction, est.pivot, 0.5, now + seen_offset)
     for _ in range(cfg.slip_steps + 2):
         opener.act_on(seen, _pose(np.eye(3), now), finger_gap=0.0)
@@ -143,7 +143,7 @@ def test_a_lid_lifted_from_below_leads_by_lid_lift_lead_and_a_gripped_one_by_rev
                                    max_step_m=1.0)
         opener = ScriptedOpener(cfg)
         opener._lid, opener._lift = True, lift
-        opener._start_pull(start, np.eye(3), est)
+        opener._start_pull(start, np.eye(3), est, "closed")
         return now + opener._pull(est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
 
     for lead in (0.12, 0.3):
@@ -173,7 +173,7 @@ def test_fingers_that_closed_on_nothing_grasp_again_the_other_way_round() -> Non
     opener.act_on(est, at_handle)
     assert opener._target_r is not None
     np.testing.assert_allclose(opener._target_r, start, atol=1e-9)  # the nearer order: the one it has
-    opener._set(Phase.CLOSE)
+    opener._set(Phase.CLOSE, "reached")
     for _ in range(cfg.close_steps):
         opener.act_on(est, at_handle, finger_gap=0.0)
     assert opener.phase == Phase.RELEASE and opener.regrasps == 1
@@ -191,7 +191,7 @@ def test_fingers_that_closed_on_nothing_grasp_again_the_other_way_round() -> Non
     for gap, other_fingers, phase in ((0.02, True, Phase.PULL), (0.0, False, Phase.PULL)):
         opener = ScriptedOpener(ScriptedOpenerConfig(regrasp_other_fingers=other_fingers))
         opener.act_on(est, at_handle)
-        opener._set(Phase.CLOSE)
+        opener._set(Phase.CLOSE, "reached")
         for _ in range(cfg.close_steps):
             opener.act_on(est, at_handle, finger_gap=gap)
         assert opener.phase == phase and opener.regrasps == 0
@@ -210,7 +210,7 @@ def _stalled_pull(arm_qpos: np.ndarray | None, cfg: ScriptedOpenerConfig) -> Scr
     opener = ScriptedOpener(cfg)
     at_handle = _pose(grasp_rotation(est, np.eye(3), cfg), est.grasp_point)
     opener.act_on(est, at_handle)
-    opener._start_pull(est.grasp_point, grasp_rotation(est, np.eye(3), cfg), est)
+    opener._start_pull(est.grasp_point, grasp_rotation(est, np.eye(3), cfg), est, "closed")
     for _ in range(cfg.stall_steps + 2):
         opener.act_on(est, at_handle, finger_gap=0.02, arm_qpos=arm_qpos)
         if opener.phase != Phase.PULL:
@@ -263,7 +263,7 @@ def _pull_stalled_at(state: float, cfg: ScriptedOpenerConfig, perceived: float |
     rot = grasp_rotation(closed, np.eye(3), cfg)
     opener = ScriptedOpener(cfg)
     opener.act_on(closed, _pose(rot, closed.grasp_point))
-    opener._start_pull(closed.grasp_point, rot, closed)
+    opener._start_pull(closed.grasp_point, rot, closed, "closed")
     est = _falling_oven(state if perceived is None else perceived)
     at = _pose(rot, _falling_oven(state).grasp_point)
     for _ in range(cfg.stall_steps + 2):
@@ -344,7 +344,7 @@ def test_a_door_that_stays_where_it_was_let_go_is_grasped_again() -> None:
     assert opener.phase == Phase.PREGRASP and len(actions) <= cfg.move_timeout + cfg.settle_window + 1
     # fingers that then close on nothing back off and grasp again without another wait: only the
     # end of a pull lets the door go
-    opener._set(Phase.CLOSE)
+    opener._set(Phase.CLOSE, "reached")
     for _ in range(cfg.close_steps + cfg.release_steps):
         opener.act_on(est, at, finger_gap=0.0)
     assert opener.phase == Phase.RETREAT
@@ -422,7 +422,7 @@ def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: f
     rot = grasp_rotation(closed, np.eye(3), cfg)
     opener = ScriptedOpener(cfg)
     opener.act_on(closed, _pose(rot, closed.grasp_point))
-    opener._start_pull(closed.grasp_point, rot, closed)
+    opener._start_pull(closed.grasp_point, rot, closed, "closed")
     turn = axis_angle_matrix(u, state)
     est = JointAxisEstimate("revolute", u, pivot, state, pivot + turn @ (closed.grasp_point - pivot))
     at = _pose(turn @ rot, est.grasp_point)
@@ -454,7 +454,7 @@ def _drawer_slipped_at(stop_at: float, cfg: ScriptedOpenerConfig) -> ScriptedOpe
     rot = grasp_rotation(est, np.eye(3), cfg)
     opener = ScriptedOpener(cfg)
     opener.act_on(est, _pose(rot, est.grasp_point))
-    opener._start_pull(est.grasp_point, rot, est)
+    opener._start_pull(est.grasp_point, rot, est, "closed")
     for k in range(1, 80):
         hand = 0.005 * k
         drawer = min(hand, stop_at)
@@ -521,7 +521,7 @@ def test_the_holding_hand_measures_a_hinge_the_estimate_has_off() -> None:
     estimate = JointAxisEstimate("revolute", axis, hinge + [0.0, 0.04, 0.0], 0.0, grasp)
     def measured(cfg: ScriptedOpenerConfig) -> float:
         opener = ScriptedOpener(cfg)
-        opener._start_pull(grasp, np.eye(3), estimate)
+        opener._start_pull(grasp, np.eye(3), estimate, "closed")
         for a in np.linspace(0.0, 0.9, 19)[1:]:
             p = hinge + axis_angle_matrix(axis, a) @ (grasp - hinge)
             opener._pull(estimate, p, np.eye(3), finger_gap=0.02)

@@ -84,3 +84,16 @@ def test_bad_worker_and_episode_counts_are_named(capsys: pytest.CaptureFixture[s
     assert "--workers" in capsys.readouterr().err
     assert main(["rollout", "--episodes", "0"]) == 2
     assert "--episodes" in capsys.readouterr().err
+
+
+def test_failed_episodes_are_counted_by_the_cause_in_their_phase_log(tmp_path: Path) -> None:
+    out, table = tmp_path / "rollout.json", tmp_path / "rollout.md"
+    # three steps: the hand is still on its way to the pre-grasp when the episode ends
+    assert main(["rollout", "--categories", "cabinet_door", "--episodes", "1", "--max-steps", "3",
+                 "--json", str(out), "--markdown", str(table)]) == 0
+    row = json.loads(out.read_text())["results"][0]
+    episode = row["episodes"][0]
+    assert episode["phase_log"] == [{"step": 0, "phase": "pregrasp", "why": "start"}]
+    assert episode["cause"] == "no grasp found" and row["failure_causes"]["no grasp found"] == 1
+    header, _, line = table.read_text().splitlines()
+    assert header.endswith("| failures by cause |") and line.endswith("| no grasp found 1 |")
