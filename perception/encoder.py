@@ -54,9 +54,24 @@ class NeighbourEmbedding(nn.Module):
         c = feat.shape[1]
         w = linear.weight[:, :, 0, 0]
         w_edge, w_centre = w[:, :c], w[:, c:]
+        if not self.training:
+            return self._forward_folded(feat, idx, w_edge, w_centre)
         edge = gather_neighbours(torch.matmul(w_edge, feat), idx)  # (B, C_out, n, k)
         centre = torch.matmul(w_centre - w_edge, feat).unsqueeze(-1)  # (B, C_out, n, 1)
         return act(norm(edge + centre)).amax(dim=-1)
+
+    def _forward_folded(self, feat: torch.Tensor, idx: torch.Tensor, w_edge: torch.Tensor,
+                        w_centre: torch.Tensor) -> torch.Tensor:
+        """Eval mode: the BatchNorm is the affine map a x + b (running statistics), folded into the
+        weights; the centre term and the shift are constant over the k neighbours, and ReLU is
+        monotone, so max_j ReLU(a E_j + C) = ReLU(max_j (a E_j) + C): only the gather and the max run
+        over the n * k edges (the normalisation, the addition and the ReLU run over n points)."""
+        norm = self.mlp[1]
+        scale = norm.weight / torch.sqrt(norm.running_var + norm.eps)
+        shift = norm.bias - scale * norm.running_mean
+        edge = gather_neighbours(torch.matmul(scale[:, None] * w_edge, feat), idx)  # (B, C_out, n, k)
+        centre = torch.matmul(scale[:, None] * (w_centre - w_edge), feat) + shift[:, None]  # (B, C_out, n)
+        return torch.relu(edge.amax(dim=-1) + centre)
 
 
 class OffsetAttention(nn.Module):
@@ -75,8 +90,10 @@ class OffsetAttention(nn.Module):
         q = self.qk(x)  # (B, C/4, n)
         energy = torch.bmm(q.transpose(1, 2), q)  # (B, n, n)
         attn = torch.softmax(energy, dim=-1)
-        attn = attn / (1e-9 + attn.sum(dim=1, keepdim=True))
-        f_sa = torch.bmm(self.v(x), attn)  # (B, C, n)
+        # The L1 normalisation divides column j of A by its sum s_j, so V A = (V softmax) / s: dividing
+        # the (C, n) product instead of the (n, n) matrix is the same up to float rounding.
+        col_sum = 1e-9 + attn.sum(dim=1, keepdim=True)  # (B, 1, n)
+        f_sa = torch.bmm(self.v(x), attn) / col_sum  # (B, C, n)
         return x + self.act(self.norm(self.trans(x - f_sa)))
 
 

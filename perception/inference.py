@@ -15,13 +15,16 @@ segmentation head.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
+from scipy.spatial import cKDTree
 
+from perception.batchnorm_folding import fold_batchnorm
 from perception.checkpoint import build_model, load_checkpoint
 from perception.config import JOINT_TYPE_CODES, CaptConfig
 from perception.model import CaptModel, CaptOutput
@@ -58,6 +61,26 @@ class ArticulationEstimate:
 
 MIN_EXTENT = 1e-4
 """m: the smallest extent an input cloud may span (identical points carry no shape)."""
+
+DEFAULT_CPU_THREADS = 1
+"""Torch threads ``predict`` uses on the CPU. One cloud is too small a job to share between cores: on
+a 2-core machine two threads gain little when idle, and when another process keeps one core busy the
+second thread's waits make a call an order of magnitude slower (benchmarks/inference_threads.md)."""
+
+
+@contextmanager
+def torch_threads(n: int | None) -> Iterator[None]:
+    """Run the block with ``torch.set_num_threads(n)`` and restore the previous count after (None: as
+    it is)."""
+    before = torch.get_num_threads()
+    if n is None or n == before:
+        yield
+        return
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
 
 
 def checked_device(device: str | torch.device) -> torch.device:
@@ -101,17 +124,11 @@ def resample_indices(num_in: int, num_out: int, seed: int) -> np.ndarray:
     return np.concatenate([np.arange(num_in), extra])
 
 
-def nearest_labels(query: np.ndarray, ref: np.ndarray, ref_labels: np.ndarray,
-                   chunk: int = 4096) -> np.ndarray:
-    """Label of the nearest ``ref`` point for each ``query`` point (Euclidean), ranking the refs by
-    |r|^2 - 2 q . r (the squared distance less the query's constant |q|^2)."""
-    ref_t = torch.as_tensor(ref, dtype=torch.float32)
-    ref_sq = ref_t.square().sum(dim=1)
-    out = np.empty(len(query), dtype=np.int64)
-    for s in range(0, len(query), chunk):
-        q = torch.as_tensor(query[s:s + chunk], dtype=torch.float32)
-        out[s:s + chunk] = ref_labels[torch.addmm(ref_sq, q, ref_t.T, alpha=-2.0).argmin(dim=1).numpy()]
-    return out
+def nearest_labels(query: np.ndarray, ref: np.ndarray, ref_labels: np.ndarray) -> np.ndarray:
+    """Label of the nearest ``ref`` point for each ``query`` point (Euclidean, float64), found with
+    scipy's k-d tree (O(N log n) rather than the N x n distance matrix)."""
+    _, nearest = cKDTree(ref).query(query, k=1)
+    return np.asarray(ref_labels)[nearest]
 
 
 def labels_for_all_points(points: np.ndarray, fed: np.ndarray, fed_labels: np.ndarray) -> np.ndarray:
@@ -131,13 +148,17 @@ class ArticulationEstimator:
 
     def __init__(self, model: CaptModel, config: CaptConfig, voting_window: tuple[float, float] | None = None,
                  category: str = "", device: str | torch.device = "cpu", seed: int = 0,
-                 double_voting: bool | None = None, outlier_filter: OutlierFilter | None = None) -> None:
+                 double_voting: bool | None = None, outlier_filter: OutlierFilter | None = None,
+                 num_threads: int | None = DEFAULT_CPU_THREADS) -> None:
         """``double_voting``: None votes as the variant was trained to (CAPT twice, CAPT-plain once);
         False makes a CAPT checkpoint vote once, the coarse mean (the paper's "CAPT w/o DV"). True is
         only for CAPT: its voting window was chosen on validation, CAPT-plain's never was.
         ``outlier_filter``: drop stray points (:mod:`perception.outlier_filter`) before normalisation and
         the network; the dropped points still get a part label, their nearest fed point's. None (the
-        default) feeds every point."""
+        default) feeds every point. ``num_threads``: torch threads while predicting on the CPU (see
+        :data:`DEFAULT_CPU_THREADS`; None leaves torch's setting alone). The network runs with its
+        BatchNorms folded into the layers before them (:mod:`perception.batchnorm_folding`, the same
+        function up to float rounding); ``model`` itself is left as it is."""
         variant = config.model.variant
         if double_voting is not None and variant == "pct_regression":
             raise ValueError("double_voting does not apply to a pct_regression checkpoint: it regresses "
@@ -148,7 +169,8 @@ class ArticulationEstimator:
         self.double_voting = config.double_voting if double_voting is None else double_voting
         self.config = config
         self.device = checked_device(device)
-        self.model = model.to(self.device).eval()
+        self.model = fold_batchnorm(model).to(self.device)
+        self.num_threads = num_threads if self.device.type == "cpu" else None
         self.voting_window = voting_window or (config.voting.w0, config.voting.w1)
         self.category = category
         self.seed = seed
@@ -158,13 +180,14 @@ class ArticulationEstimator:
     @classmethod
     def from_checkpoint(cls, path: str | Path, device: str | torch.device = "cpu", seed: int = 0,
                         double_voting: bool | None = None,
-                        outlier_filter: OutlierFilter | None = None) -> ArticulationEstimator:
+                        outlier_filter: OutlierFilter | None = None,
+                        num_threads: int | None = DEFAULT_CPU_THREADS) -> ArticulationEstimator:
         """Load a checkpoint written by :func:`perception.checkpoint.save_checkpoint`
-        (``double_voting`` and ``outlier_filter`` as in the constructor)."""
+        (``double_voting``, ``outlier_filter`` and ``num_threads`` as in the constructor)."""
         ckpt = load_checkpoint(path)
         device = checked_device(device)
         return cls(build_model(ckpt, device), ckpt.config, ckpt.voting_window, ckpt.category, device, seed,
-                   double_voting, outlier_filter)
+                   double_voting, outlier_filter, num_threads)
 
     def _fed_points(self, points: np.ndarray) -> np.ndarray:
         """Indices of the points of one checked cloud that may be fed to the network: all of them, or the
@@ -179,9 +202,12 @@ class ArticulationEstimator:
         frame (+z up for a yaw-trained model; see the module docstring)."""
         return self.predict_batch([points])[0]
 
-    @torch.no_grad()
     def predict_batch(self, clouds: Sequence[np.ndarray]) -> list[ArticulationEstimate]:
         """:meth:`predict` for several clouds in one forward pass; ``latency_ms`` = batch time / count."""
+        with torch_threads(self.num_threads), torch.inference_mode():
+            return self._predict_batch(clouds)
+
+    def _predict_batch(self, clouds: Sequence[np.ndarray]) -> list[ArticulationEstimate]:
         t0 = time.perf_counter()
         if len(clouds) == 0:
             return []

@@ -39,18 +39,11 @@ class _DeprecatedAlias(argparse.Action):
 
 
 def add_deprecated_alias(parser: argparse.ArgumentParser, old: str, new: str) -> None:
-    """Make ``old`` a hidden alias of the option ``new`` (same dest, nargs, type and choices). A verb
-    module that still declares ``old`` itself has that option renamed to ``new`` (its dest kept)."""
+    """Make ``old`` a hidden alias of the option ``new`` (same dest, nargs, type and choices)."""
     actions = parser._option_string_actions  # argparse's option-string -> action map
     if new not in actions:
-        if old not in actions:
-            raise ValueError(f"{parser.prog} has neither {old} nor {new}")
-        canonical = actions.pop(old)
-        canonical.option_strings = [new if s == old else s for s in canonical.option_strings]
-        if canonical.metavar is None and canonical.nargs != 0:
-            canonical.metavar = new.lstrip("-").replace("-", "_").upper()
-        actions[new] = canonical
-    elif old in actions:
+        raise ValueError(f"{parser.prog} has no {new}")
+    if old in actions:
         raise ValueError(f"{parser.prog} declares both {old} and {new}")
     canonical = actions[new]
     parser.add_argument(old, action=_DeprecatedAlias, canonical=canonical, dest=argparse.SUPPRESS,

@@ -195,6 +195,12 @@ class CaptSource:
         """Forget the previous episode's estimates."""
         self._fusion.reset()
 
+    @property
+    def estimator(self) -> Any:
+        """The :class:`perception.inference.ArticulationEstimator` of ``checkpoint`` (loaded on first
+        use)."""
+        return self._load()
+
     def _load(self) -> Any:
         if self._estimator is None:
             from perception.inference import ArticulationEstimator  # lazy: only the capt source
