@@ -82,7 +82,8 @@ def main() -> None:
                     runs[side] += run_side(base_tree if side == "base" else ROOT, cat, args.first_seed,
                                            args.episodes)
             row = {side: {"seconds_per_episode_mean": statistics.mean(e["seconds"] for e in eps),
-                          "seconds_per_step_mean": sum(e["seconds"] for e in eps) / sum(e["steps"] for e in eps),
+                          "seconds_per_step_mean": (sum(e["seconds"] for e in eps)
+                                                    / sum(e["steps"] for e in eps)),
                           "success": statistics.mean(float(e["success"]) for e in eps),
                           "episodes": eps} for side, eps in runs.items()}
             row["speedup"] = row["base"]["seconds_per_episode_mean"] / row["tree"]["seconds_per_episode_mean"]
