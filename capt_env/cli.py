@@ -25,14 +25,23 @@ VERBS: dict[str, tuple[str, str]] = {
     "noise-sweep": ("noise_sweep", "success rate against the size of one joint-estimate error"),
     "estimate-errors": ("estimate_errors", "errors of the wrapper's CAPT estimate on unseen env resets"),
     "inspect-object": ("inspect_object", "check a user's URDF/MJCF file: joints, front, reach, a PNG"),
-    "bench": ("bench", "environment speed: steps/s in state and pointcloud mode, reset time"),
+    "bench": ("bench", "speed: env steps/s per obs mode, env + CAPT on both render paths, CAPT per cloud"),
 }
+
+
+class DefaultsHelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """argparse's defaults formatter, except where the help already says what the default is (a
+    default of None that means "the config's" or "the shipped one" is stated in words)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        return text if "(default" in text or "; default" in text else super()._get_help_string(action)
 
 
 def _add_verb(sub: argparse._SubParsersAction, verb: str, with_arguments: bool) -> None:
     module, help_text = VERBS[verb]
     p = sub.add_parser(verb, help=help_text, description=help_text,
-                       formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+                       formatter_class=DefaultsHelpFormatter)
     if not with_arguments:
         return
     mod = importlib.import_module(f"capt_env.commands.{module}")
