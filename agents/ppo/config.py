@@ -133,8 +133,8 @@ class PPOTrainConfig:
         require(self.category in CATEGORY_ENV_NAMES,
                 f"category: unknown {self.category!r}; known: {sorted(CATEGORY_ENV_NAMES)}")
         self.perception.validate()
-        require(self.perception.source != "capt" or self.obs_mode == "pointcloud",
-                "perception.source 'capt' needs obs_mode: pointcloud")
+        require(not self.perception.reads_points or self.obs_mode == "pointcloud",
+                f"perception.source '{self.perception.source}' needs obs_mode: pointcloud")
         require(self.perception.obs_format == "flat",
                 "perception.obs_format must be 'flat' (MlpPolicy takes the 38-float Box)")
         require(self.n_envs >= 1, f"n_envs must be >= 1, got {self.n_envs}")

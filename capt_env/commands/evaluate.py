@@ -1,4 +1,9 @@
-"""``capt evaluate``: the paper's Table I (and Table II timing) for one or more checkpoints, side by side."""
+"""``capt evaluate``: the paper's Table I (and Table II timing) for one or more checkpoints, side by side.
+
+Every number is the network's own estimate, the ``capt_raw`` perception source (double voting as the
+variant has it, no geometric refiners: those need the scene around a look, which a dataset cloud
+does not have); the table says so, and ``capt estimate-errors`` scores the refined ``capt`` source.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +16,9 @@ from capt_common.json_report import write_json
 if TYPE_CHECKING:
     from perception.corruption import Corruption
     from perception.outlier_filter import OutlierFilter
+
+PERCEPTION_SOURCE = "capt_raw"
+"""What a dataset cloud is scored with: the network alone (see the module docstring)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -72,8 +80,9 @@ def run(args: argparse.Namespace) -> int:
     if outlier_filter is not None:
         noise += (f"Stray points filtered before the network: {outlier_filter.neighbours} neighbours, "
                   f"std ratio {outlier_filter.std_ratio:g}.\n\n")
-    text = (f"{pose}{noise}{result.table}\n\nTime per input (median over >= {args.timing_clouds} clouds, "
-            f"device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")
+    source = f"Perception source: `{PERCEPTION_SOURCE}` (the network alone, no refiners).\n\n"
+    text = (f"{source}{pose}{noise}{result.table}\n\nTime per input (median over >= {args.timing_clouds} "
+            f"clouds, device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")
     print(text)
     if args.markdown:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
@@ -86,7 +95,8 @@ def run(args: argparse.Namespace) -> int:
     summary = {m: {c: summarise([r for r in result.results if r.method == m and r.category == c])
                    for c in categories} for m in methods}
     write_json(args.json, {
-        "split": args.split, "test_pose": args.test_pose, "test_corruption": dataclasses.asdict(corruption),
+        "perception": PERCEPTION_SOURCE, "split": args.split, "test_pose": args.test_pose,
+        "test_corruption": dataclasses.asdict(corruption),
         "outlier_filter": None if outlier_filter is None else dataclasses.asdict(outlier_filter),
         "data": args.data, "checkpoints": args.checkpoints,
         "median_ms_per_input": result.median_ms, "summary": summary, "table_markdown": result.table,

@@ -26,7 +26,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--model", default=None,
                         help="PPO model .zip (with --policy ppo; default: the category's shipped policy)")
     parser.add_argument("--perception", nargs="+", default=["oracle"],
-                        choices=["oracle", "noisy_oracle", "capt"], help="perception sources to compare")
+                        choices=["oracle", "noisy_oracle", "capt_raw", "capt"],
+                        help="perception sources to compare (capt_raw: the network alone; capt: refined)")
     parser.add_argument("--checkpoint", default=None, help="CAPT checkpoint (default: the shipped one)")
     parser.add_argument("--episodes", type=int, default=10, help="episodes per category and source")
     parser.add_argument("--first-seed", type=int, default=0, help="episodes use seeds first..first+n-1")
@@ -142,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
             if source == "noisy_oracle":
                 wrapper["noise"] = noise
             obs_mode = "state"
-            if source == "capt":
+            if source in ("capt_raw", "capt"):
                 from perception.checkpoints import default_checkpoint
 
                 wrapper["checkpoint"] = str(args.checkpoint or default_checkpoint(like))
@@ -152,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
                              model, opener, args.max_steps)
             log = None if args.episode_log is None else EpisodeLog(args.episode_log, job.identity())
             episodes = play_episodes(job, seeds, args.workers, log, desc=f"{target.label} {source}")
-            used = Path(wrapper["checkpoint"]).stem if source == "capt" else (model and Path(model).stem)
+            used = Path(wrapper["checkpoint"]).stem if "checkpoint" in wrapper else model and Path(model).stem
             row = {"object": target.label, "category": target.category, "task": job.task,
                    "policy": args.policy, "model": model, "perception": source,
                    "checkpoint": wrapper.get("checkpoint"), "like": like,

@@ -6,8 +6,12 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from capt_common.typed_yaml import require
+from capt_env.wrappers.estimate_fusion import FusionConfig
+from capt_env.wrappers.refiners import REFINER_NAMES, RefinerName, RefinerSettings, check_refiner_names
 
-Source = Literal["oracle", "noisy_oracle", "capt"]
+Source = Literal["oracle", "noisy_oracle", "capt_raw", "capt"]
+CAPT_SOURCES: tuple[str, ...] = ("capt_raw", "capt")
+"""The sources that run the CAPT network on the object's points (and need a checkpoint)."""
 IsolationMode = Literal["segmentation", "geometric"]
 ObsFormat = Literal["flat", "dict"]
 NoiseModel = Literal["gaussian", "fixed_offset"]
@@ -86,28 +90,19 @@ class NoiseConfig:
 class PerceptionWrapperConfig:
     """What :class:`~capt_env.wrappers.perception_wrapper.CaptObservationWrapper` does.
 
-    ``source``: ``oracle`` (ground truth from info), ``noisy_oracle`` (ground truth + ``noise``) or
-    ``capt`` (a CAPT ``checkpoint``, loaded lazily on first use). Perception runs on reset and then
-    every ``every_k_steps`` steps; in between the last estimate is repeated. ``isolation`` selects the
+    ``source``: ``oracle`` (ground truth from info), ``noisy_oracle`` (ground truth + ``noise``),
+    ``capt_raw`` (the CAPT ``checkpoint``'s own estimate: the network with double voting, no
+    geometric refiners, no fusion) or ``capt`` (that estimate refined and fused over the episode);
+    the checkpoint is loaded lazily on first use. The stages are listed in
+    :mod:`~capt_env.wrappers.estimate_pipeline`. Perception runs on reset and then every
+    ``every_k_steps`` steps; in between the last estimate is repeated. ``isolation`` selects the
     object points fed to CAPT, downsampled to ``num_points``. ``obs_format``: ``flat`` (Box) or
-    ``dict``. ``seed`` seeds noise and downsampling. ``hinge_on_part_edge`` (``capt`` only): put a
-    revolute estimate's line on the edge of the flat moving part away from the grasp point, in the
-    part's plane, when CAPT's own line is more than 6 cm off that edge, and turn the direction into
-    the part's plane (``moving_part_geometry.hinge_on_edge``); off, the line is CAPT's own.
-    ``order_stacked_parts`` (``capt`` only): when the model has several prismatic joints (a stack of
-    drawers, numbered from the bottom as in the dataset), the target drawer's grasp point is the
-    target-index-th handle from the bottom on the stack's front (``stacked_parts``), not the handle
-    of the part CAPT labels with the target's index (it often gives a drawer its neighbour's label);
-    with fewer handles in view, CAPT's label decides. ``dense_geometry`` (``capt`` only): look for
-    handles among all isolated object points rather than the ``num_points`` fed to CAPT (a handle is
-    a few of those, kept by one draw and lost by the next). ``slide_along_front`` (``capt`` only): a
-    prismatic estimate slides along the normal of its part's flat front (a plane fitted to hundreds
-    of points) when that front faces within 0.6 rad of CAPT's direction; off, the direction is
-    CAPT's own, only its sign set by the front. ``panel_max_state`` (``capt`` only, rad, 0 off):
-    while CAPT's state of a revolute joint is under it (the part is about closed), the hinge edge
-    and the handle are looked for on the whole flat panel the moving part lies on (its in-plane
-    points joined to it: ``moving_part_geometry.coplanar_panel``), not only on the points CAPT
-    labels as moving (it can label the handle's half of a door only).
+    ``dict``. ``seed`` seeds noise and downsampling.
+
+    ``capt`` only: ``refiners`` names the geometric refiners that run (any order; they run in the
+    pipeline's order, :data:`~capt_env.wrappers.refiners.REFINER_NAMES`; default all, ``[]`` none),
+    ``refiner_settings`` holds each refiner's config (:class:`~capt_env.wrappers.refiners.RefinerSettings`,
+    whose defaults are the only ones) and ``fusion`` the fusion of successive looks.
     """
 
     source: Source = "oracle"
@@ -118,18 +113,22 @@ class PerceptionWrapperConfig:
     noise: NoiseConfig = field(default_factory=NoiseConfig)
     obs_format: ObsFormat = "flat"
     seed: int = 0
-    hinge_on_part_edge: bool = True
-    order_stacked_parts: bool = True
-    dense_geometry: bool = True
-    slide_along_front: bool = True
-    panel_max_state: float = 0.35
+    refiners: tuple[RefinerName, ...] = REFINER_NAMES
+    refiner_settings: RefinerSettings = field(default_factory=RefinerSettings)
+    fusion: FusionConfig = field(default_factory=FusionConfig)
+
+    @property
+    def reads_points(self) -> bool:
+        """Whether the source reads the object's points (needs ``obs_mode="pointcloud"``)."""
+        return self.source in CAPT_SOURCES
 
     def validate(self) -> None:
         require(self.every_k_steps >= 1, f"every_k_steps must be >= 1, got {self.every_k_steps}")
         require(self.num_points >= 32, f"num_points must be >= 32, got {self.num_points}")
-        require(0.0 <= self.panel_max_state <= 3.15,
-                f"panel_max_state must be in [0, pi] rad, got {self.panel_max_state}")
-        if self.source == "capt":
-            require(self.checkpoint is not None, "source 'capt' needs a checkpoint path")
+        if self.source in CAPT_SOURCES:
+            require(self.checkpoint is not None, f"source '{self.source}' needs a checkpoint path")
+        check_refiner_names(self.refiners)
         self.isolation.validate()
         self.noise.validate()
+        self.refiner_settings.validate()
+        self.fusion.validate()

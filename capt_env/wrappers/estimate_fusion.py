@@ -28,8 +28,11 @@ with it, measured).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from capt_common.typed_yaml import require
 from capt_env.objects.geometry import rotate_about_axis
 from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, unit
 
@@ -48,11 +51,29 @@ def robust_centre(points: list[np.ndarray], weights: list[float]) -> np.ndarray:
     return out
 
 
-class EstimateFusion:
-    """Running confidence-weighted fusion; call :meth:`reset` at every episode start."""
+@dataclass(frozen=True)
+class FusionConfig:
+    """``state_tolerance`` (rad or m): the part counts as not moved while the state is within it of
+    the first look's; ``handle_jump_m`` (m) and ``handle_jump_share`` (of the slide): a handle seen on
+    a slid-out part farther than both from where the slide carried the last one is not trusted."""
 
-    def __init__(self, state_tolerance: float = 0.05, handle_jump_m: float = 0.05,
-                 handle_jump_share: float = 0.5) -> None:
+    state_tolerance: float = 0.05
+    handle_jump_m: float = 0.05
+    handle_jump_share: float = 0.5
+
+    def validate(self) -> None:
+        require(self.state_tolerance >= 0 and self.handle_jump_share >= 0 and self.handle_jump_m > 0,
+                "fusion.state_tolerance and fusion.handle_jump_share must be >= 0, "
+                "fusion.handle_jump_m > 0")
+
+
+class EstimateFusion:
+    """Running confidence-weighted fusion; call :meth:`reset` at every episode start. The defaults
+    are :class:`FusionConfig`'s (``EstimateFusion(**asdict(config))``)."""
+
+    def __init__(self, state_tolerance: float = FusionConfig.state_tolerance,
+                 handle_jump_m: float = FusionConfig.handle_jump_m,
+                 handle_jump_share: float = FusionConfig.handle_jump_share) -> None:
         if state_tolerance < 0 or handle_jump_m <= 0 or handle_jump_share < 0:
             raise ValueError("state_tolerance and handle_jump_share must be >= 0, handle_jump_m > 0")
         self.state_tolerance = state_tolerance

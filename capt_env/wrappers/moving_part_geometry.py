@@ -49,6 +49,14 @@ def part_plane(object_points: np.ndarray, part_points: np.ndarray) -> PartPlane 
     return PartPlane(centre, vt[:2], normal)
 
 
+def faces_along(plane: PartPlane | None, direction: np.ndarray, max_angle: float = 0.6) -> bool:
+    """Whether ``plane``'s normal is within ``max_angle`` rad of the line of ``direction`` (3,): a
+    drawer's front faces along its slide. False for no plane."""
+    if plane is None:
+        return False
+    return abs(float(plane.outward @ unit(direction))) >= float(np.cos(max_angle))
+
+
 def coplanar_panel(object_points: np.ndarray, part_points: np.ndarray, plane: PartPlane,
                    band: float = 0.01, link_radius: float = 0.03) -> np.ndarray:
     """The flat panel a segmented part lies on: the points (K, 3) of ``object_points`` (N, 3) within

@@ -4,14 +4,16 @@ Per perception run (on reset, then every ``every_k_steps`` steps): isolate the o
 the world-frame cloud (``isolation.mode``), downsample them to ``num_points`` (seeded), estimate the
 target joint with the configured source, and keep the estimate. Every step the observation is the
 proprioception of that step plus the latest estimate (layout: :mod:`capt_env.wrappers.joint_observation`).
+For the CAPT sources these are the stages of :mod:`~capt_env.wrappers.estimate_pipeline`: this
+wrapper runs the first (isolate) and the last (observe), the source the ones between.
 
 ``info`` gains ``perception_ran`` (bool, perception ran on this step) and ``object_points`` (int,
 isolated object points of the last run; -1 when the source reads no cloud). The wall-clock time of
 the last run (isolation + estimate, ms) is the attribute ``last_perception_latency_ms``, not an
 ``info`` entry, so that a step's info depends only on the seed and the actions (Gymnasium's
 determinism check).
-Oracle sources work with any obs mode; ``capt`` needs ``obs_mode="pointcloud"``. The cameras render
-only on the steps perception looks at them (never for oracle sources): the base env repeats its
+Oracle sources work with any obs mode; ``capt_raw`` and ``capt`` need ``obs_mode="pointcloud"``. The
+cameras render only on the steps perception looks at them (never for oracle sources): the base env repeats its
 last observation in between, which changes nothing the wrapper returns.
 """
 
@@ -26,18 +28,10 @@ import numpy as np
 from capt_common.typed_yaml import from_dict
 from capt_env.wrappers.config import PerceptionWrapperConfig
 from capt_env.wrappers.estimate import JointAxisEstimate
-from capt_env.wrappers.joint_observation import build_dict, dict_space, flat_space, flatten
-from capt_env.wrappers.object_isolation import isolate
+from capt_env.wrappers.estimate_pipeline import isolate_object, network_input, observe
+from capt_env.wrappers.joint_observation import dict_space, flat_space
 from capt_env.wrappers.perception_sources import PerceptionSource, make_source
 from capt_env.wrappers.robot_filter import RobotPointFilter
-
-
-def downsample(points: np.ndarray, num: int, rng: np.random.Generator) -> np.ndarray:
-    """``num`` rows of ``points`` (M, 3): a random subset, or all plus random repeats if M < num."""
-    if len(points) >= num:
-        return points[np.sort(rng.choice(len(points), num, replace=False))]
-    extra = rng.choice(len(points), num - len(points), replace=True)
-    return np.concatenate([points, points[extra]])
 
 
 class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
@@ -53,10 +47,7 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         cfg = from_dict(PerceptionWrapperConfig, config or {}, where="perception_wrapper")
         cfg.validate()
         self.config = cfg
-        self.source: PerceptionSource = make_source(cfg.source, cfg.noise, cfg.checkpoint, cfg.seed,
-                                                     cfg.hinge_on_part_edge, cfg.order_stacked_parts,
-                                                     cfg.dense_geometry, cfg.slide_along_front,
-                                                     cfg.panel_max_state)
+        self.source: PerceptionSource = make_source(cfg)
         obs_mode = getattr(env.unwrapped, "obs_mode", None)
         if self.source.needs_points and obs_mode != "pointcloud":
             raise ValueError(
@@ -109,9 +100,8 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
                     self._estimate = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3),
                                                        0.0, np.zeros(3), 0.0)
                 return (time.perf_counter() - t0) * 1000.0
-            dense = points
-            points = downsample(points, self.config.num_points, self._rng)
-            self._estimate = self.source.estimate(points, info, dense_points=dense)
+            fed = network_input(points, self.config.num_points, self._rng)
+            self._estimate = self.source.estimate(fed, info, dense_points=points)
         else:
             self._estimate = self.source.estimate(None, info)
         return (time.perf_counter() - t0) * 1000.0
@@ -120,8 +110,7 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         cloud = obs["pointcloud"]
         if self.config.isolation.mode == "geometric" and self._robot_filter is None:
             self._robot_filter = RobotPointFilter(self.env.unwrapped.agent.robot)
-        mask = isolate(cloud["xyzw"], cloud.get("part_label"), self.config.isolation, self._robot_filter)
-        points = np.asarray(cloud["xyzw"][mask, :3], dtype=np.float64)
+        points = isolate_object(cloud, self.config.isolation, self._robot_filter)
         self._object_points = len(points)
         return points
 
@@ -137,8 +126,7 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
 
     def _observation(self) -> Any:
         assert self._estimate is not None
-        obs = build_dict(*self.proprioception(), self._estimate)
-        return flatten(obs) if self.config.obs_format == "flat" else obs
+        return observe(*self.proprioception(), self._estimate, self.config.obs_format)
 
     def _info(self, info: dict, ran: bool, latency: float) -> dict:
         if ran:

@@ -81,6 +81,7 @@ def test_shipped_configs_load() -> None:
     ({"task": {"split": "test"}}, "split"),
     ({"task": {"yaw_nois": 0.1}}, "yaw_nois"),
     ({"perception": {"source": "capt", "checkpoint": "x.pt"}}, "pointcloud"),
+    ({"perception": {"source": "capt_raw", "checkpoint": "x.pt"}}, "pointcloud"),
     ({"device": "tpu"}, "device"),
     ({"residual": {"enabled": True, "scale": 0.0}}, "residual.scale"),
     ({"residual": {"enable": True}}, "enable"),
@@ -143,7 +144,7 @@ def test_train_save_reload_resume(tmp_path: Path) -> None:
     assert train_ppo(tiny(total_timesteps=128), run)["steps_this_run"] == 0
     # a run saved before a config field existed resumes with that field's default
     saved = yaml.safe_load((run / "config.yaml").read_text())
-    del saved["continue_after_success"], saved["perception"]["hinge_on_part_edge"]
+    del saved["continue_after_success"], saved["perception"]["refiners"]
     (run / "config.yaml").write_text(yaml.safe_dump(saved))
     assert train_ppo(tiny(total_timesteps=128), run)["steps_this_run"] == 0
     # a resume may not change what is trained

@@ -148,17 +148,24 @@ def test_estimate_errors_on_constructed_estimates() -> None:
 
 
 def test_estimate_errors_hinge_on_door_edge_beats_capt_line(tmp_path: Path) -> None:
-    """Two unseen cabinet doors: on the door's edge the hinge line is within 5 cm and at most half as far
-    off as CAPT's own (the session-23 model's own: 1.6 and 6.5 cm; on the edge 2.8 and 0.1 cm)."""
-    out = tmp_path / "errors.json"
+    """Two unseen cabinet doors, each looked at once and scored raw, refined and refined without
+    ``hinge_on_edge``: on the door's edge the hinge line is within 5 cm and at most half as far off as
+    without it (the network's own line: 1.6 and 6.5 cm; on the edge 2.8 and 0.1 cm), and every row
+    names its perception source."""
+    out, table = tmp_path / "errors.json", tmp_path / "errors.md"
     repo = Path(__file__).resolve().parents[2]
-    assert main(["estimate-errors", "--categories", "cabinet_door", "--episodes", "2",
-                 "--task", str(repo / "configs/tasks/two_cameras.yaml"), "--json", str(out)]) == 0
-    off, on = json.loads(out.read_text())["results"]
-    assert not off["hinge_on_part_edge"] and on["hinge_on_part_edge"]
-    assert all(r["line_m"] < 0.05 for r in on["per_reset"])
-    assert on["line_m_mean"] < 0.5 * off["line_m_mean"]
-    assert on["direction_deg_mean"] < off["direction_deg_mean"]
+    assert main(["estimate-errors", "--categories", "cabinet_door", "--episodes", "2", "--task",
+                 str(repo / "configs/tasks/two_cameras.yaml"), "--without-refiner", "hinge_on_edge",
+                 "--json", str(out), "--markdown", str(table)]) == 0
+    raw, refined, without = json.loads(out.read_text())["results"]
+    assert [r["perception"] for r in (raw, refined, without)] == ["capt_raw", "capt", "capt"]
+    assert [r["refiners"] for r in (raw, refined, without)] == ["none", "all", "all but hinge_on_edge"]
+    assert all(r["line_m"] < 0.05 for r in refined["per_reset"])
+    assert refined["line_m_mean"] < 0.5 * without["line_m_mean"]
+    assert refined["direction_deg_mean"] < raw["direction_deg_mean"]
+    assert any("hinge_on_edge" in r["fired"] for r in refined["per_reset"])
+    assert all(r["fired"] == [] for r in raw["per_reset"])
+    assert "| capt_raw | none |" in table.read_text() and "| capt | all |" in table.read_text()
 
 
 def test_train_config_takes_the_command_line_overrides(tmp_path: Path) -> None:

@@ -1,4 +1,5 @@
-"""CaptSource's geometry on a constructed drawer cloud, with a stand-in for the network."""
+"""The ``capt`` source end to end (its refiners together, as the wrapper config builds them) on
+constructed clouds, with a stand-in for the network."""
 
 from __future__ import annotations
 
@@ -7,8 +8,22 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from capt_env.wrappers.perception_sources import CaptSource
+from capt_common.typed_yaml import from_dict
+from capt_env.wrappers.config import PerceptionWrapperConfig
+from capt_env.wrappers.perception_sources import CaptSource, make_source
+from capt_env.wrappers.refiners import REFINER_NAMES, without
 from perception.inference import ArticulationEstimate, JointEstimate
+
+
+def _capt(network: object, refiners: tuple[str, ...] = REFINER_NAMES, **settings: dict) -> CaptSource:
+    """The ``capt`` source of the wrapper config with ``refiners`` and ``refiner_settings``, its
+    network replaced by ``network``."""
+    config = from_dict(PerceptionWrapperConfig, {"source": "capt", "checkpoint": "unused.pt",
+                                                 "refiners": list(refiners), "refiner_settings": settings})
+    source = make_source(config)
+    assert isinstance(source, CaptSource)
+    source._estimator = network
+    return source
 
 
 def _drawer_cloud(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -42,13 +57,12 @@ def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.degrees(np.arccos(np.clip(a @ b / np.linalg.norm(a) / np.linalg.norm(b), -1.0, 1.0))))
 
 
-@pytest.mark.parametrize("slide_along_front, max_error_deg, min_error_deg", [(True, 0.5, 0.0),
-                                                                              (False, 10.5, 9.5)])
-def test_a_drawer_slides_along_its_front_normal(slide_along_front: bool, max_error_deg: float,
+@pytest.mark.parametrize("front_normal, max_error_deg, min_error_deg", [(True, 0.5, 0.0),
+                                                                         (False, 10.5, 9.5)])
+def test_a_drawer_slides_along_its_front_normal(front_normal: bool, max_error_deg: float,
                                                 min_error_deg: float) -> None:
     points, labels = _drawer_cloud(np.random.default_rng(0))
-    source = CaptSource("unused.pt", slide_along_front=slide_along_front)
-    source._estimator = _Network(labels)
+    source = _capt(_Network(labels), REFINER_NAMES if front_normal else without("front_normal"))
     est = source.estimate(points, {"target_joint": np.array([0])})
     error = _angle_deg(est.direction, np.array([-1.0, 0.0, 0.0]))
     assert min_error_deg <= error <= max_error_deg
@@ -95,8 +109,7 @@ class _StackNetwork:
 
 def test_the_bottom_drawer_is_found_when_the_segmented_stack_is_not_flat() -> None:
     points, labels = _three_drawer_cloud(np.random.default_rng(0))
-    source = CaptSource("unused.pt", order_stacked_parts=True, slide_along_front=True)
-    source._estimator = _StackNetwork(labels)
+    source = _capt(_StackNetwork(labels))
     est = source.estimate(points, {"target_joint": np.array([0])})
     np.testing.assert_allclose(est.grasp_point, [-0.03, 0.0, 0.09], atol=0.015)  # not between two bars
 
@@ -108,8 +121,7 @@ def test_a_low_handle_with_few_points_still_counts_in_a_stack() -> None:
     dense, labels = _three_drawer_cloud(np.random.default_rng(1), bars=(8, 160, 160), front=1200,
                                         carcass_as_top_drawer=False)
     keep = np.random.default_rng(2).permutation(len(dense))[: len(dense) // 4]
-    source = CaptSource("unused.pt", order_stacked_parts=True, dense_geometry=True, slide_along_front=True)
-    source._estimator = _StackNetwork(labels[keep])
+    source = _capt(_StackNetwork(labels[keep]))
     est = source.estimate(dense[keep], {"target_joint": np.array([0])}, dense_points=dense)
     np.testing.assert_allclose(est.grasp_point, [-0.03, 0.0, 0.09], atol=0.015)
 
@@ -147,8 +159,7 @@ class _DoorNetwork:
 def test_a_closed_door_labelled_by_half_is_hinged_on_its_whole_panel(panel_max_state: float, state: float,
                                                                       hinge_y: float) -> None:
     points, labels = _half_labelled_door(np.random.default_rng(0))
-    source = CaptSource("unused.pt", hinge_on_part_edge=True, panel_max_state=panel_max_state)
-    source._estimator = _DoorNetwork(labels, state)
+    source = _capt(_DoorNetwork(labels, state), coplanar_panel={"max_state": panel_max_state})
     est = source.estimate(points, {"target_joint": np.array([0])})
     np.testing.assert_allclose(est.grasp_point[:2], [-0.23, 0.16], atol=0.01)  # the handle
     # on the panel the line is the door's far edge; without it (or once CAPT says the door is open)

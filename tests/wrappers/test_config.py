@@ -26,7 +26,13 @@ CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "wrappers"
         ({"isolation": {"workspace_min": [1, 0, 0], "workspace_max": [0, 1, 1]}}, "workspace"),
         ({"isolation": {"outlier_k": 0}}, "outlier_k"),
         ({"every_k": 2}, "every_k"),
-        ({"panel_max_state": -0.1}, "panel_max_state"),
+        ({"refiner_settings": {"coplanar_panel": {"max_state": -0.1}}}, "max_state"),
+        ({"refiner_settings": {"hinge": {}}}, "hinge"),
+        ({"refiners": ["handle", "magic"]}, "refiners"),
+        ({"refiners": ["handle", "handle"]}, "each name once"),
+        ({"fusion": {"handle_jump_m": 0.0}}, "handle_jump_m"),
+        ({"source": "capt_raw"}, "checkpoint"),
+        ({"hinge_on_part_edge": True}, "hinge_on_part_edge"),
     ],
 )
 def test_bad_values_raise_config_error(data: dict, needle: str) -> None:

@@ -253,7 +253,7 @@ def test_a_handle_a_sparse_draw_loses_is_found_among_all_points() -> None:
     """A dense cloud (16x the model's input) with a small knob (64 points, 4 expected in a 1/16 draw,
     2 in this unlucky one): the draw alone has too few handle points; all points, with the minimum
     scaled 16x, find the knob."""
-    from capt_env.wrappers.perception_sources import handle_search_points
+    from capt_env.wrappers.refiners.dense_handle_search import handle_search_points
 
     rng = np.random.default_rng(3)
     door = np.stack([np.zeros(8000), rng.uniform(-0.2, 0.2, 8000), rng.uniform(0.0, 0.4, 8000)], axis=1)

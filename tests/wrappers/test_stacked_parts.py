@@ -52,8 +52,7 @@ def test_too_few_handles_in_view_gives_none() -> None:
 
 
 def test_a_drawer_front_faces_along_the_slide_its_bottom_does_not() -> None:
-    from capt_env.wrappers.moving_part_geometry import PartPlane
-    from capt_env.wrappers.perception_sources import faces_along
+    from capt_env.wrappers.moving_part_geometry import PartPlane, faces_along
 
     slide = np.array([-1.0, 0.05, 0.0])
     front = PartPlane(np.zeros(3), np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), np.array([-1.0, 0.0, 0.0]))

@@ -1,0 +1,61 @@
+"""Refiner ``handle``: the grasp point is the handle standing off the moving part's face.
+
+Geometric reason: a handle is the part of a door, drawer front or lid that stands furthest out of
+its flat face, 1.2-8 cm (``min_standoff``..``max_standoff``), within the face's extent; the network's
+fallback, the part's far edge, is a strip along the whole edge. The search runs on the draft's
+``handle_cloud`` (all object points: a segmentation may miss thin handle points) against the
+``panel``'s plane and extent. A bar is centred across its thickness too (the cameras see one side
+of it), except on a part swinging about a horizontal hinge (an oven door, a lid): measured, that
+moved an oven's grasp point off its bar.
+Must not fire: when a refiner already found the handle (``stacked_parts``), the part is not flat (or
+a prismatic part's face does not face along its slide), or too few points stand off the face.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from capt_common.typed_yaml import require
+from capt_env.wrappers.moving_part_geometry import handle_point
+from capt_env.wrappers.refiners.draft import Draft
+
+
+@dataclass(frozen=True)
+class HandleConfig:
+    """``min_standoff``..``max_standoff`` (m): how far out of the face handle points stand;
+    ``margin`` (m): the face's in-plane extent is grown by it; ``vertical_hinge_min_z``: a hinge whose
+    unit direction has at least this |z| counts as vertical (its handle is centred across the bar)."""
+
+    min_standoff: float = 0.012
+    max_standoff: float = 0.08
+    margin: float = 0.1
+    vertical_hinge_min_z: float = 0.5
+
+    def validate(self) -> None:
+        require(0.0 <= self.min_standoff < self.max_standoff,
+                "handle.min_standoff must be >= 0 and below handle.max_standoff (metres)")
+        require(self.margin >= 0, "handle.margin must be >= 0 (metres)")
+        require(0.0 <= self.vertical_hinge_min_z <= 1.0, "handle.vertical_hinge_min_z must be in [0, 1]")
+
+
+class Handle:
+    """Set the draft's grasp point to the centre of the handle on its moving part's face."""
+
+    name: ClassVar[str] = "handle"
+
+    def __init__(self, config: HandleConfig | None = None) -> None:
+        self.config = config or HandleConfig()
+
+    def refine(self, draft: Draft) -> bool:
+        if draft.grasp is not None or draft.settled or draft.plane is None:
+            return False
+        c = self.config
+        across = draft.joint_type == "prismatic" or abs(float(draft.direction[2])) >= c.vertical_hinge_min_z
+        grasp = handle_point(draft.handle_cloud, draft.panel, min_standoff=c.min_standoff,
+                             max_standoff=c.max_standoff, margin=c.margin,
+                             min_points=draft.handle_min_points, plane=draft.plane, centre_across=across)
+        if grasp is None:
+            return False
+        draft.grasp, draft.from_handle = grasp, True
+        return True
