@@ -168,7 +168,9 @@ def run(args: argparse.Namespace) -> int:
         with open(args.markdown, "w") as fh:
             fh.write(text + "\n")
     if args.json:
-        write_json(args.json, {"command": "estimate-errors", "seeds": seeds, "task": args.task,
+        # no "command" key of our own: write_json records the command line under it
+        write_json(args.json, {"verb": "estimate-errors", "seeds": seeds, "task": args.task,
+                               "perception": args.perception, "without_refiner": args.without_refiner,
                                "results": results})
     return 0
 
