@@ -9,6 +9,11 @@ here. Variants:
 - ``pct_regression``: the paper's "PCT" baseline: same encoder, max+mean pooled global feature, one MLP
   that regresses per joint direction (3), pivot (3) and state (1). No motion loss, no voting; a
   segmentation head only when ``regression_seg_head`` is true (the paper's PCT row has none).
+
+A joint slot's type is fixed by the category (``revolute``, ``prismatic``) or ``any``: the network
+then predicts the slot's type (revolute, prismatic or absent) from its global feature, so one model
+serves objects of every category without being told which (the cross-category model,
+``configs/perception/capt_cross_category.yaml``).
 """
 
 from __future__ import annotations
@@ -21,15 +26,18 @@ from capt_common.typed_yaml import require
 from perception.corruption import Corruption
 
 Variant = Literal["capt", "capt_plain", "pct_regression"]
-JointType = Literal["revolute", "prismatic"]
+JointType = Literal["revolute", "prismatic", "any"]
 JOINT_TYPE_CODES: dict[str, int] = {"revolute": 0, "prismatic": 1}
+SLOT_TYPES = ("revolute", "prismatic", "absent")
+"""The classes a slot-type head predicts, in logit order; a slot whose joint is absent is class 2."""
 
 
 @dataclass(frozen=True)
 class ModelConfig:
     """Network shape. ``embed_dim`` is d_e: each of the four offset-attention layers is d_e wide and
     their concatenation gives 4*d_e per-point features. ``max_parts`` (n_L) and ``max_joints`` (n_J)
-    size the output channels for the category; ``joint_types`` names the type of every joint slot."""
+    size the output channels for the category; ``joint_types`` names the type of every joint slot
+    (``any``: predicted per object, see the module docstring)."""
 
     variant: Variant = "capt"
     num_points: int = 1024
@@ -67,6 +75,11 @@ class ModelConfig:
         return self.variant != "pct_regression" or self.regression_seg_head
 
     @property
+    def predicts_joint_types(self) -> bool:
+        """Whether a slot-type head predicts each slot's type (some slot is ``any``)."""
+        return "any" in self.joint_types
+
+    @property
     def per_point(self) -> bool:
         """Whether the network predicts per-point articulation (and so needs voting)."""
         return self.variant != "pct_regression"
@@ -74,7 +87,8 @@ class ModelConfig:
 
 @dataclass(frozen=True)
 class LossWeights:
-    """The paper's W = [seg, dir, pdir, dist, state, motion] = [1, 1, 1, 1, 1, 0.1]."""
+    """The paper's W = [seg, dir, pdir, dist, state, motion] = [1, 1, 1, 1, 1, 0.1], plus the weight of
+    the slot-type cross-entropy (used only by a model with ``any`` slots)."""
 
     seg: float = 1.0
     dir: float = 1.0
@@ -82,9 +96,10 @@ class LossWeights:
     dist: float = 1.0
     state: float = 1.0
     motion: float = 0.1
+    slot_type: float = 1.0
 
     def validate(self) -> None:
-        for name in ("seg", "dir", "pdir", "dist", "state", "motion"):
+        for name in ("seg", "dir", "pdir", "dist", "state", "motion", "slot_type"):
             require(getattr(self, name) >= 0.0, f"loss.weights.{name} must be >= 0")
 
 

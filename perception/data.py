@@ -276,18 +276,31 @@ def prepare_sample(sample: Sample, num_points: int, rng: np.random.Generator) ->
     }
 
 
+def load_splits(data_dirs: Sequence[str | Path], split: str, num_joints: int) -> dict[str, np.ndarray]:
+    """:func:`load_split` of every directory, each fitted to ``num_joints`` slots, concatenated (the
+    training set of a cross-category model: one directory per category)."""
+    arrays = [fit_joint_slots(load_split(d, split), num_joints) for d in data_dirs]
+    shapes = {a["points"].shape[1:] for a in arrays}
+    if len(shapes) > 1:
+        raise ValueError(f"the datasets {[str(d) for d in data_dirs]} store clouds of different sizes "
+                         f"{sorted(shapes)}; generate them with one num_points")
+    return {k: np.concatenate([a[k] for a in arrays]) for k in arrays[0]}
+
+
 class CaptShardDataset(Dataset):
-    """A split of a shard directory as training tensors (see module docstring). ``max_samples`` keeps
+    """A split of a shard directory (or of several, concatenated in order: one per category for a
+    cross-category model) as training tensors (see module docstring). ``max_samples`` keeps
     the first samples only. ``pose`` puts every sample in its fixed seeded pose first (see
     :func:`posed_sample`; validation and test clouds), before any augmentation. ``sensor_noise`` is added
     to augmented clouds only (:func:`add_sensor_noise`). Call :meth:`set_epoch` each epoch to change the
     augmentation draw."""
 
-    def __init__(self, data_dir: str | Path, split: str, model: ModelConfig, augment: bool = False,
-                 seed: int = 0, max_samples: int | None = None, rotation: str = "so3",
-                 pose: str = "world", sensor_noise: Corruption | None = None) -> None:
+    def __init__(self, data_dir: str | Path | Sequence[str | Path], split: str, model: ModelConfig,
+                 augment: bool = False, seed: int = 0, max_samples: int | None = None,
+                 rotation: str = "so3", pose: str = "world", sensor_noise: Corruption | None = None) -> None:
         check_pose(pose)
-        arrays = fit_joint_slots(load_split(data_dir, split), model.max_joints)
+        dirs = [data_dir] if isinstance(data_dir, (str, Path)) else list(data_dir)
+        arrays = load_splits(dirs, split, model.max_joints)
         if max_samples is not None:
             arrays = {k: v[:max_samples] for k, v in arrays.items()}
         self.arrays = arrays
@@ -304,8 +317,8 @@ class CaptShardDataset(Dataset):
         a = self.arrays
         if a["part_labels"].max() >= model.max_parts:
             raise ValueError(f"part label {a['part_labels'].max()} >= model.max_parts {model.max_parts}")
-        want = np.array([JOINT_TYPE_CODES[t] for t in model.joint_types])
-        bad = a["joint_mask"] & (a["joint_types"] != want[None, :])
+        want = np.array([JOINT_TYPE_CODES.get(t, -1) for t in model.joint_types])
+        bad = a["joint_mask"] & (want[None, :] >= 0) & (a["joint_types"] != want[None, :])
         if bad.any():
             raise ValueError(f"joint types in data differ from model.joint_types {model.joint_types}")
 

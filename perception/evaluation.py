@@ -71,8 +71,10 @@ def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg
                                   state_error(j.state, float(sample.joint_states[k]), j.type)))
     pa = segmentation_accuracy(est.part_labels, labels[obj]) if has_seg else None
     miou = mean_iou(est.part_labels, labels[obj]) if has_seg else None
+    true_joints = int(np.asarray(sample.joint_mask).sum())
     return SampleResult(sample.category, method, pa, miou, tuple(joints), est.latency_ms,
-                        int(sample.instance_id))
+                        int(sample.instance_id), missed_joints=true_joints - len(joints),
+                        true_joints=true_joints)
 
 
 WITHOUT_DV = "capt_without_dv"

@@ -88,3 +88,20 @@ class RegressionHead(nn.Module):
     def forward(self, global_feat: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         raw = self.mlp(global_feat).reshape(-1, self.num_joints, 7)
         return F.normalize(raw[..., 0:3], dim=-1, eps=1e-6), raw[..., 3:6], raw[..., 6]
+
+
+class SlotTypeHead(nn.Module):
+    """Cross-category slots: global feature -> per joint slot logits over :data:`perception.config.
+    SLOT_TYPES` (revolute, prismatic, absent), (B, J, 3). Which joints an object has is a property of
+    the whole object, so it is read from the pooled feature, not voted per point."""
+
+    def __init__(self, in_dim: int, hidden: int, num_joints: int, dropout: float) -> None:
+        super().__init__()
+        self.num_joints = num_joints
+        self.mlp = nn.Sequential(
+            nn.Linear(in_dim, hidden, bias=False), nn.BatchNorm1d(hidden), nn.ReLU(inplace=True),
+            nn.Dropout(dropout), nn.Linear(hidden, 3 * num_joints),
+        )
+
+    def forward(self, global_feat: torch.Tensor) -> torch.Tensor:
+        return self.mlp(global_feat).reshape(-1, self.num_joints, 3)

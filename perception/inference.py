@@ -26,7 +26,7 @@ from scipy.spatial import cKDTree
 
 from perception.batchnorm_folding import fold_batchnorm
 from perception.checkpoint import build_model, load_checkpoint
-from perception.config import JOINT_TYPE_CODES, CaptConfig
+from perception.config import JOINT_TYPE_CODES, SLOT_TYPES, CaptConfig
 from perception.model import CaptModel, CaptOutput
 from perception.normalisation import Normalisation
 from perception.outlier_filter import OutlierFilter, inlier_mask
@@ -39,7 +39,9 @@ MIN_POINTS = 32
 class JointEstimate:
     """One joint in the caller's frame: ``direction`` (3,) unit (+state opens), ``pivot`` (3,) metres (a
     point on the axis; display point for prismatic), ``state`` radians (revolute) or metres (prismatic),
-    ``confidence`` in [0, 1]."""
+    ``confidence`` in [0, 1]. ``joint_index`` is the model's joint slot; a cross-category model
+    (``any`` slots) leaves out the slots it predicts absent and gives the others their predicted
+    ``type``."""
 
     joint_index: int
     type: str
@@ -224,6 +226,14 @@ class ArticulationEstimator:
         latency = (time.perf_counter() - t0) * 1000.0 / len(checked)
         return [ArticulationEstimate(labels, joints, latency) for labels, joints in results]
 
+    def _slot_types(self, out: CaptOutput, b: int) -> list[str]:
+        """Each slot's type for cloud ``b``: the config's, or for an ``any`` slot the slot-type head's
+        most likely class (revolute, prismatic or absent)."""
+        if out.slot_type_logits is None:
+            return list(self.joint_types)
+        predicted = out.slot_type_logits[b].argmax(dim=-1).cpu().tolist()
+        return [SLOT_TYPES[c] if t == "any" else t for t, c in zip(self.joint_types, predicted, strict=True)]
+
     def _decode(self, out: CaptOutput, b: int, points: np.ndarray, net_points: np.ndarray, idx: np.ndarray,
                 norm: Normalisation) -> tuple[np.ndarray, tuple[JointEstimate, ...]]:
         cfg = self.config.model
@@ -233,7 +243,9 @@ class ArticulationEstimator:
         else:
             kept_labels = None
             labels = np.full(len(points), -1, dtype=np.int64)
-        codes = [JOINT_TYPE_CODES[t] for t in self.joint_types]
+        types = self._slot_types(out, b)
+        present = [k for k, t in enumerate(types) if t != "absent"]
+        codes = [JOINT_TYPE_CODES.get(t, 0) for t in types]
         if out.dir is not None:
             assert out.dist is not None and out.pdir is not None and out.state is not None
             child = None
@@ -256,11 +268,13 @@ class ArticulationEstimator:
         joints = []
         centre = norm.centre
         for k, (u, q, s, conf) in enumerate(raw):
+            if k not in present:
+                continue
             pivot = norm.points_inv(q)
             if codes[k] == JOINT_TYPE_CODES["revolute"]:
                 pivot = pivot + float((centre - pivot) @ u) * u
             state = float(norm.length_inv(s)) if codes[k] == JOINT_TYPE_CODES["prismatic"] else float(s)
-            joints.append(JointEstimate(k, self.joint_types[k], np.asarray(u, dtype=np.float64),
+            joints.append(JointEstimate(k, types[k], np.asarray(u, dtype=np.float64),
                                         np.asarray(pivot, dtype=np.float64), state,
                                         float(np.clip(conf, 0.0, 1.0))))
         return labels, tuple(joints)

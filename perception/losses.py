@@ -121,5 +121,19 @@ def capt_losses(out: CaptOutput, batch: dict[str, torch.Tensor], config: CaptCon
         parts["state"] = masked_mean((out.reg_state - batch["joint_states"]).abs(), jmask)
         total = (w.seg * parts["seg"] + w.dir * parts["dir"] + w.dist * parts["pivot"]
                  + w.state * parts["state"])
+    if out.slot_type_logits is not None:
+        parts["slot_type"] = slot_type_loss(out.slot_type_logits, types, jmask)
+        total = total + w.slot_type * parts["slot_type"]
     parts["total"] = total
     return parts
+
+
+def slot_type_targets(types: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """(B, J) class of each slot in :data:`perception.config.SLOT_TYPES`: its joint type where ``mask``
+    holds a joint, 2 (absent) elsewhere."""
+    return torch.where(mask, types, torch.full_like(types, 2))
+
+
+def slot_type_loss(logits: torch.Tensor, types: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """Cross-entropy of the slot-type logits (B, J, 3) against :func:`slot_type_targets`."""
+    return F.cross_entropy(logits.reshape(-1, 3), slot_type_targets(types, mask).reshape(-1))

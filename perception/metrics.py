@@ -107,7 +107,9 @@ class JointResult:
 @dataclass(frozen=True)
 class SampleResult:
     """Metrics of one evaluated cloud; ``pa``/``miou`` None when the method has no segmentation;
-    ``instance_id`` the object instance the cloud shows (a test split has several views of each)."""
+    ``instance_id`` the object instance the cloud shows (a test split has several views of each);
+    ``missed_joints`` the cloud's joints the method gave no estimate for (a cross-category model that
+    predicted their slot absent) and ``true_joints`` how many it has."""
 
     category: str
     method: str
@@ -116,6 +118,8 @@ class SampleResult:
     joints: tuple[JointResult, ...] = field(default_factory=tuple)
     time_ms: float | None = None
     instance_id: int | None = None
+    missed_joints: int = 0
+    true_joints: int = 0
 
 
 def _share_above(errors: Sequence[float], threshold: float) -> float:
@@ -137,13 +141,14 @@ def summarise(results: Sequence[SampleResult]) -> dict[str, float | list[float]]
         "pa": _mean([r.pa for r in results]),
         "miou": _mean([r.miou for r in results]),
         "time_ms": _mean([r.time_ms for r in results]),
+        "joints_missed": sum(r.missed_joints for r in results) / max(1, sum(r.true_joints for r in results)),
     }
-    num_joints = max((len(r.joints) for r in results), default=0)
+    slots = sorted({j.joint_index for r in results for j in r.joints})
     keys = ["dir_med", "dir_ap5", "dir_ap10", "pos_aed", "pos_ap1", "pos_ap5", "state_med", "state_ap5",
             "state_ap10", "dir_median", "dir_flipped"]
     cols: dict[str, list[float]] = {k: [] for k in keys}
-    for k in range(num_joints):
-        js = [r.joints[k] for r in results if len(r.joints) > k]
+    for k in slots:  # by joint slot (true joints fill the first slots, so this is their order)
+        js = [j for r in results for j in r.joints if j.joint_index == k]
         d = [j.direction_error_deg for j in js]
         p = [j.position_error for j in js if j.position_error is not None]
         s = [j.state_error for j in js]

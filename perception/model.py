@@ -12,7 +12,7 @@ from torch import nn
 
 from perception.config import ModelConfig
 from perception.encoder import PCTEncoder
-from perception.heads import ArticulationHead, RegressionHead, SegmentationHead
+from perception.heads import ArticulationHead, RegressionHead, SegmentationHead, SlotTypeHead
 
 
 @dataclass
@@ -21,7 +21,8 @@ class CaptOutput:
     fields are None for the voting variants; ``seg_logits`` is None without a segmentation head.
 
     seg_logits (B, n, n_L); dir (B, n, J, 3) unit; dist (B, n, J) >= 0; pdir (B, n, J, 3) unit;
-    state (B, n, J) radians or normalised length; reg_dir (B, J, 3); reg_pivot (B, J, 3); reg_state (B, J).
+    state (B, n, J) radians or normalised length; reg_dir (B, J, 3); reg_pivot (B, J, 3); reg_state (B, J);
+    slot_type_logits (B, J, 3) over revolute, prismatic, absent (models with ``any`` slots only).
     """
 
     seg_logits: torch.Tensor | None = None
@@ -32,6 +33,7 @@ class CaptOutput:
     reg_dir: torch.Tensor | None = None
     reg_pivot: torch.Tensor | None = None
     reg_state: torch.Tensor | None = None
+    slot_type_logits: torch.Tensor | None = None
 
     def pivots(self, points: torch.Tensor) -> torch.Tensor:
         """Per-point pivot votes p + dist * pdir, (B, n, J, 3); ``points`` (B, n, 3)."""
@@ -58,6 +60,8 @@ class CaptModel(nn.Module):
             self.art_head = None
             self.reg_head = RegressionHead(self.encoder.global_dim, config.head_dim, config.max_joints,
                                            config.dropout)
+        self.slot_type_head = (SlotTypeHead(self.encoder.global_dim, config.head_dim, config.max_joints,
+                                            config.dropout) if config.predicts_joint_types else None)
 
     def forward(self, points: torch.Tensor) -> CaptOutput:
         """``points`` (B, n, 3) float, normalised object frame -> :class:`CaptOutput`."""
@@ -71,4 +75,6 @@ class CaptModel(nn.Module):
             out.dir, out.dist, out.pdir, out.state = self.art_head(per_point, global_feat)
         if self.reg_head is not None:
             out.reg_dir, out.reg_pivot, out.reg_state = self.reg_head(global_feat)
+        if self.slot_type_head is not None:
+            out.slot_type_logits = self.slot_type_head(global_feat)
         return out

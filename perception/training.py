@@ -12,6 +12,7 @@ from __future__ import annotations
 import csv
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,7 +29,7 @@ from perception.losses import capt_losses
 from perception.model import CaptModel, CaptOutput
 from perception.voting import PointPredictions, choose_voting_window
 
-LOSS_NAMES = ("total", "seg", "dir", "pdir", "dist", "state", "motion", "pivot")
+LOSS_NAMES = ("total", "seg", "dir", "pdir", "dist", "state", "motion", "pivot", "slot_type")
 
 
 @dataclass(frozen=True)
@@ -106,7 +107,8 @@ def collect_point_predictions(model: CaptModel, dataset: CaptShardDataset, devic
             preds.append(PointPredictions(batch["points"][i].numpy(), out.dir[i].cpu().numpy(),
                                           out.dist[i].cpu().numpy(), out.pdir[i].cpu().numpy(),
                                           out.state[i].cpu().numpy(), child))
-            gts.append({k: batch[k][i].numpy() for k in ("joint_dirs", "joint_pivots", "joint_mask")})
+            gts.append({k: batch[k][i].numpy()
+                        for k in ("joint_dirs", "joint_pivots", "joint_mask", "joint_types")})
     return preds, gts
 
 
@@ -117,9 +119,11 @@ def choose_window_on(model: CaptModel, dataset: CaptShardDataset, config: TrainC
     if not cfg.double_voting or len(dataset) == 0:
         return cfg.voting.w0, cfg.voting.w1
     preds, gts = collect_point_predictions(model, dataset, device, config.batch_size)
-    types = [JOINT_TYPE_CODES[t] for t in cfg.model.joint_types]
+    types = [JOINT_TYPE_CODES.get(t, -1) for t in cfg.model.joint_types]
+    # an ``any`` slot votes as the type of each validation object's own joint there
+    sample_types = [np.where(np.asarray(types) >= 0, types, np.maximum(g["joint_types"], 0)) for g in gts]
     w0, w1, _ = choose_voting_window(preds, [g["joint_dirs"] for g in gts], [g["joint_pivots"] for g in gts],
-                                     [g["joint_mask"] for g in gts], types, cfg.voting.grid_w0,
+                                     [g["joint_mask"] for g in gts], sample_types, cfg.voting.grid_w0,
                                      cfg.voting.grid_w1, cfg.voting.min_points)
     return w0, w1
 
@@ -139,9 +143,11 @@ def extend_cosine_schedule(optimizer: torch.optim.Optimizer,
     scheduler._last_lr = [group["lr"] for group in optimizer.param_groups]
 
 
-def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume: bool = True,
+def train(config: TrainConfig, data_dir: str | Path | Sequence[str | Path], out_dir: str | Path,
+          resume: bool = True,
           stop_after: int | None = None, init_from: str | Path | None = None) -> TrainResult:
-    """Train ``config.model`` on ``data_dir`` (shard layout of :mod:`perception.data`) into ``out_dir``.
+    """Train ``config.model`` on ``data_dir`` (shard layout of :mod:`perception.data`; several
+    directories train one cross-category model) into ``out_dir``.
 
     ``resume``: continue from ``out_dir/last.pt`` when present (its model config must match).
     ``stop_after``: run at most this many epochs in this call (time-sliced jobs); a later call resumes.
@@ -165,7 +171,7 @@ def train(config: TrainConfig, data_dir: str | Path, out_dir: str | Path, resume
                                 max_samples=config.max_train_samples, sensor_noise=config.sensor_noise)
     val_ds = CaptShardDataset(data_dir, config.val_split, mcfg, augment=False, seed=config.seed + 1,
                               max_samples=config.max_val_samples, pose=config.val_pose)
-    category = str(train_ds.arrays["category"][0]) if len(train_ds) else ""
+    category = "+".join(dict.fromkeys(str(c) for c in train_ds.arrays["category"]))
     model = CaptModel(mcfg).to(device)
     optimizer = torch.optim.AdamW(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
     scheduler = torch.optim.lr_scheduler.CosineAnnealingLR(optimizer, T_max=config.epochs)

@@ -100,18 +100,22 @@ def vote(pred: PointPredictions, joint_types: Sequence[int], w0: float, w1: floa
 
 def window_error(votes: Sequence[Sequence[JointVote]], gt_dirs: Sequence[np.ndarray],
                  gt_pivots: Sequence[np.ndarray], gt_masks: Sequence[np.ndarray],
-                 joint_types: Sequence[int], dir_scale_deg: float = 10.0, pos_scale: float = 0.05) -> float:
+                 joint_types: Sequence[int] | Sequence[Sequence[int]], dir_scale_deg: float = 10.0,
+                 pos_scale: float = 0.05) -> float:
     """Mean over present joints of direction error / ``dir_scale_deg`` + line distance / ``pos_scale``
-    (the second for revolute joints only); the AP10 and AP5 thresholds make the two comparable."""
+    (the second for revolute joints only); the AP10 and AP5 thresholds make the two comparable.
+    ``joint_types``: per slot, or per sample and slot (see :func:`choose_voting_window`)."""
     from perception.metrics import direction_error_deg, line_distance
 
     errs = []
-    for sample_votes, dirs, pivots, mask in zip(votes, gt_dirs, gt_pivots, gt_masks, strict=True):
+    per_sample = _types_per_sample(joint_types, len(votes))
+    for sample_votes, dirs, pivots, mask, types in zip(votes, gt_dirs, gt_pivots, gt_masks, per_sample,
+                                                       strict=True):
         for k, v in enumerate(sample_votes):
             if not mask[k]:
                 continue
             e = direction_error_deg(v.direction, dirs[k]) / dir_scale_deg
-            if joint_types[k] == REVOLUTE:
+            if types[k] == REVOLUTE:
                 e += line_distance(v.direction, v.pivot, dirs[k], pivots[k]) / pos_scale
             errs.append(e)
     return float(np.mean(errs)) if errs else 0.0
@@ -119,21 +123,33 @@ def window_error(votes: Sequence[Sequence[JointVote]], gt_dirs: Sequence[np.ndar
 
 def choose_voting_window(preds: Sequence[PointPredictions], gt_dirs: Sequence[np.ndarray],
                          gt_pivots: Sequence[np.ndarray], gt_masks: Sequence[np.ndarray],
-                         joint_types: Sequence[int], grid_w0: Sequence[float], grid_w1: Sequence[float],
-                         min_points: int = 8) -> tuple[float, float, float]:
+                         joint_types: Sequence[int] | Sequence[Sequence[int]], grid_w0: Sequence[float],
+                         grid_w1: Sequence[float], min_points: int = 8) -> tuple[float, float, float]:
     """Grid-search (w0, w1) on validation predictions (normalised frame) to minimise
-    :func:`window_error`; returns (w0, w1, error). Ties keep the first pair in grid order."""
+    :func:`window_error`; returns (w0, w1, error). Ties keep the first pair in grid order.
+    ``joint_types`` gives each slot's type for every sample, or one sequence per sample (a
+    cross-category model's slots have each object's own types)."""
     if not preds:
         raise ValueError("choose_voting_window needs at least one validation sample")
+    per_sample = _types_per_sample(joint_types, len(preds))
     best: tuple[float, float, float] | None = None
     for w0 in grid_w0:
         for w1 in grid_w1:
             if not w0 < w1:
                 continue
-            votes = [vote(p, joint_types, w0, w1, True, min_points) for p in preds]
+            votes = [vote(p, t, w0, w1, True, min_points) for p, t in zip(preds, per_sample, strict=True)]
             err = window_error(votes, gt_dirs, gt_pivots, gt_masks, joint_types)
             if best is None or err < best[2] - 1e-12:
                 best = (float(w0), float(w1), err)
     if best is None:
         raise ValueError("no (w0, w1) pair in the grids has w0 < w1")
     return best
+
+
+def _types_per_sample(joint_types: Sequence[int] | Sequence[Sequence[int]], n: int) -> list[Sequence[int]]:
+    """``joint_types`` as one sequence of slot types per sample (a shared per-slot sequence repeated)."""
+    if len(joint_types) and np.ndim(joint_types[0]) > 0:
+        if len(joint_types) != n:
+            raise ValueError(f"got slot types for {len(joint_types)} samples, need {n}")
+        return list(joint_types)
+    return [joint_types] * n

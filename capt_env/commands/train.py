@@ -13,7 +13,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", default="capt",
                         help="TrainConfig: a shipped name (capt, capt_plain, pct_regression, ...) or a YAML "
                              "path")
-    parser.add_argument("--data", required=True, help="dataset directory made by `capt generate`")
+    parser.add_argument("--data", required=True, nargs="+",
+                        help="dataset directory made by `capt generate`; several (one per category) "
+                             "train one cross-category model (--config capt_cross_category)")
     parser.add_argument("--out", required=True, help="run directory: last.pt, best.pt, log.csv")
     parser.add_argument("--epochs", type=int, default=None, help="override the config's epochs")
     parser.add_argument("--device", default=None, help="auto, cpu or cuda[:i] (default: the config's)")
@@ -27,27 +29,53 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "one); ignored when resuming from last.pt")
 
 
-def train_config_for(config_path: str, data_dir: str, epochs: int | None, device: str | None,
-                     seed: int | None = None):
-    """The YAML TrainConfig with the model's output channels set for the dataset's category, and the
-    command line's overrides (``None``: keep the config's)."""
-
-    from capt_common.typed_yaml import from_dict, load_yaml, to_dict
-    from capt_env.dataset.category_structure import category_structure
-    from perception.config import TrainConfig
-
+def dataset_category(data_dir: str | Path) -> str:
+    """The category a ``capt generate`` directory holds (from its manifest)."""
     manifest = Path(data_dir) / "manifest.json"
     if not manifest.is_file():
         raise SystemExit(f"{data_dir} has no manifest.json: make it with `capt generate`")
-    category = json.loads(manifest.read_text())["config"]["category"]
-    from capt_env.shipped_configs import resolve_config
+    return json.loads(manifest.read_text())["config"]["category"]
 
+
+def train_config_for(config_path: str, data_dirs: str | list[str], epochs: int | None, device: str | None,
+                     seed: int | None = None):
+    """The YAML TrainConfig with the model's output channels set for the dataset's category (a config
+    with ``any`` joint slots keeps its own: every dataset's category must fit them), and the command
+    line's overrides (``None``: keep the config's). Returns the config and the category label
+    (categories joined by ``+`` for a cross-category model)."""
+
+    from capt_common.typed_yaml import from_dict, load_yaml, to_dict
+    from capt_env.dataset.category_structure import category_structure
+    from capt_env.shipped_configs import resolve_config
+    from perception.config import TrainConfig
+
+    dirs = [data_dirs] if isinstance(data_dirs, str) else list(data_dirs)
+    categories = [dataset_category(d) for d in dirs]
     cfg = to_dict(load_yaml(TrainConfig, resolve_config("perception", config_path)))
-    cfg["model"]["model"].update(category_structure(category))
+    model = cfg["model"]["model"]
+    if "any" not in model["joint_types"]:
+        if len(dirs) > 1:
+            raise SystemExit(f"--data {' '.join(dirs)}: several datasets train one cross-category model, "
+                             f"whose config has 'any' joint slots (--config capt_cross_category)")
+        model.update(category_structure(categories[0]))
+    else:
+        for category in categories:
+            _check_fits_slots(category, category_structure(category), model)
+    category = categories[0] if len(categories) == 1 else "+".join(categories)
     for key, value in {"epochs": epochs, "device": device, "seed": seed}.items():
         if value is not None:
             cfg[key] = value
     return from_dict(TrainConfig, cfg), category
+
+
+def _check_fits_slots(category: str, structure: dict, model: dict) -> None:
+    """SystemExit unless ``category``'s joints fit the cross-category model's slots: no more parts or
+    joints, and joint ``k``'s child part is slot ``k``'s."""
+    n = structure["max_joints"]
+    if structure["max_parts"] > model["max_parts"] or n > model["max_joints"] or (
+            list(structure["joint_child_parts"]) != list(model["joint_child_parts"][:n])):
+        raise SystemExit(f"{category}: {structure} does not fit the model's slots (max_parts "
+                         f"{model['max_parts']}, joint_child_parts {model['joint_child_parts']})")
 
 
 def run(args: argparse.Namespace) -> int:
