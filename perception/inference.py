@@ -231,8 +231,14 @@ class ArticulationEstimator:
         most likely class (revolute, prismatic or absent)."""
         if out.slot_type_logits is None:
             return list(self.joint_types)
-        predicted = out.slot_type_logits[b].argmax(dim=-1).cpu().tolist()
-        return [SLOT_TYPES[c] if t == "any" else t for t, c in zip(self.joint_types, predicted, strict=True)]
+        logits = out.slot_type_logits[b].float().cpu()
+        predicted = logits.argmax(dim=-1).tolist()
+        types = [SLOT_TYPES[c] if t == "any" else t for t, c in zip(self.joint_types, predicted, strict=True)]
+        if all(t == "absent" for t in types):  # an object has a joint: keep the likeliest slot
+            margin = logits[:, :2].max(dim=-1).values - logits[:, 2]
+            k = int(margin.argmax())
+            types[k] = SLOT_TYPES[int(logits[k, :2].argmax())]
+        return types
 
     def _decode(self, out: CaptOutput, b: int, points: np.ndarray, net_points: np.ndarray, idx: np.ndarray,
                 norm: Normalisation) -> tuple[np.ndarray, tuple[JointEstimate, ...]]:

@@ -109,3 +109,15 @@ def test_a_category_dataset_with_other_types_is_refused_by_a_fixed_model(tmp_pat
     else:
         raise AssertionError("a revolute model accepted prismatic data")
     CaptShardDataset(d, "train", replace(tiny_model_config(), joint_types=("any",)))
+
+
+def test_an_object_seen_with_every_slot_absent_keeps_its_likeliest_joint():
+    cfg = cross_config()
+    model = CaptModel(cfg.model).eval()
+    last = model.slot_type_head.mlp[-1]
+    with torch.no_grad():  # every slot "absent", slot 1 the least so, and prismatic over revolute
+        last.weight.zero_()
+        last.bias.copy_(torch.tensor([0.0, 1.0, 9.0, 0.0, 2.0, 5.0]))
+    joints = ArticulationEstimator(model, cfg, num_threads=1).predict(
+        np.asarray(make_samples(1)[0].points, np.float64)).joints
+    assert [(j.joint_index, j.type) for j in joints] == [(1, "prismatic")]

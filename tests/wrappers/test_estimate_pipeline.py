@@ -132,3 +132,16 @@ def test_the_wrapper_observes_capt_raw_on_a_rendered_scene() -> None:
         assert refined.last_draft is not None and refined.last_draft.fired  # something to refine
     finally:
         env.close()
+
+
+def test_a_target_slot_the_network_found_absent_takes_its_most_confident_joint():
+    from capt_env.wrappers.refiners.draft import network_draft
+    from perception.inference import ArticulationEstimate, JointEstimate
+
+    pts = np.random.default_rng(0).uniform(-0.2, 0.2, size=(50, 3))
+    found = [JointEstimate(1, "prismatic", np.array([0.0, -1.0, 0.0]), np.zeros(3), 0.1, 0.6),
+             JointEstimate(2, "prismatic", np.array([0.0, -1.0, 0.0]), np.zeros(3), 0.2, 0.9)]
+    result = ArticulationEstimate(np.zeros(50, np.int64), tuple(found), 1.0)
+    draft = network_draft(result, pts, target=0, model=None)
+    assert draft.target == 2 and draft.state == 0.2
+    assert network_draft(result, pts, target=1, model=None).target == 1

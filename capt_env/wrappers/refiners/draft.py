@@ -134,10 +134,14 @@ def network_draft(result: ArticulationEstimate, points: np.ndarray, target: int,
     """The draft of the network's estimate ``result`` of the cloud ``points`` (M, 3) for joint
     ``target`` (clipped to the joints the model has): its own type, direction, pivot, state and
     confidence; the moving part is the points labelled with the joint's child part (all points when
-    fewer than 3 are, or the model names no child parts). ``model``: the model's config."""
+    fewer than 3 are, or the model names no child parts). ``model``: the model's config. A
+    cross-category model reports only the slots it finds present: when the target slot is not among
+    them, the most confident joint it found stands in."""
     points = np.asarray(points, dtype=np.float64)
-    k = min(int(target), len(result.joints) - 1)
-    joint = result.joints[k]
+    by_slot = {j.joint_index: j for j in result.joints}
+    k = min(int(target), max(by_slot))
+    joint = by_slot.get(k) or max(result.joints, key=lambda j: j.confidence)
+    k = joint.joint_index
     labels = np.asarray(result.part_labels)
     moving = points
     child_parts = getattr(model, "joint_child_parts", None)
