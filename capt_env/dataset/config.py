@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from capt_common.typed_yaml import require
+from capt_env.dataset.variation import Variation
 from capt_env.tasks.config import CameraConfig
 
 # Joint slots stored per sample; a category with fewer joints leaves the rest masked out.
@@ -25,6 +26,11 @@ class GenerateConfig:
     ``joint``, ``closed``, ``front_yaw``) to render instead of a procedural category; ``category`` is
     then only the label stored with each sample (the file stem by default), and every split holds
     views of the one file.
+
+    ``variation``: varied geometry (panel shapes, handle kinds, interiors), distractors on the
+    table, robot-centric viewpoints and depth-sensor noise (:mod:`capt_env.dataset.variation`, each
+    documented with its units there); all off by default, which renders exactly what a config
+    without the key always rendered.
     """
 
     category: str = "laptop"
@@ -38,6 +44,7 @@ class GenerateConfig:
     camera: CameraConfig = field(
         default_factory=lambda: CameraConfig(width=160, height=160, random_view=True, fov=0.9)
     )
+    variation: Variation = field(default_factory=Variation)
 
     def validate(self) -> None:
         from capt_env.objects.registry import CATEGORIES
@@ -57,3 +64,4 @@ class GenerateConfig:
         require(self.min_object_points >= 1, "min_object_points must be >= 1")
         require(self.camera.random_view, "dataset cameras must use random_view: true")
         self.camera.validate()
+        self.variation.validate()

@@ -8,8 +8,10 @@ Layout of an output directory::
 
 Keys of a shard (S samples, N = ``num_points``, J = ``MAX_JOINTS``; world frame, metres, radians):
 
-    points (S,N,3) float32       object points only (robot, table and background removed by labels)
-    part_labels (S,N) int64      part of each point (0 = base, k + 1 = moved by joint k)
+    points (S,N,3) float32       object points (robot and table removed by labels), plus distractor
+                                 points with ``variation.distractors``
+    part_labels (S,N) int64      part of each point (0 = base, k + 1 = moved by joint k; -1 = a
+                                 distractor, background)
     joint_types (S,J) int64      0 revolute, 1 prismatic (-1 in unused slots)
     joint_dirs (S,J,3) float32   unit axis direction, +state opens
     joint_pivots (S,J,3) float32 the point of the axis closest to the cloud's centroid
@@ -25,6 +27,10 @@ Keys of a shard (S samples, N = ``num_points``, J = ``MAX_JOINTS``; world frame,
 Each shard is a pure function of (config, split, shard index) and is written atomically (temporary
 file, then rename), so an interrupted run resumes by skipping the shards that exist: nothing is
 lost or duplicated. Shards are rendered in parallel, one process and one environment per core.
+
+``GenerateConfig.variation`` (:mod:`capt_env.dataset.variation`) renders a varied scene
+(:mod:`capt_env.dataset.scene_env`) and adds sensor noise (:mod:`capt_env.dataset.sensor_noise`);
+with all of it off the shards, and the manifest, are exactly those of a config without it.
 """
 
 from __future__ import annotations
@@ -76,7 +82,7 @@ _ENV_KEY: tuple | None = None
 
 def _env_for(cfg: GenerateConfig) -> Any:
     global _ENV, _ENV_KEY
-    key = (cfg.category, json.dumps(cfg.object, sort_keys=True), to_json(cfg.camera))
+    key = (cfg.category, json.dumps(cfg.object, sort_keys=True), to_json(cfg.camera), to_json(cfg.variation))
     if _ENV is None or _ENV_KEY != key:
         import gymnasium as gym
 
@@ -92,8 +98,15 @@ def _env_for(cfg: GenerateConfig) -> Any:
             "object_xy": [0.3, 0.0],
             "target_init_fraction": [0.0, 1.0], "other_init_fraction": [0.0, 1.0],
         }
-        _ENV = gym.make(capt_env.registration.GENERIC_ID, obs_mode="pointcloud", task=task,
-                        reconfiguration_freq=0)
+        if cfg.variation.viewpoints.mode == "robot":
+            del task["object_xy"]  # where the task puts the object: robot-centric views
+        if cfg.variation.needs_scene:
+            from capt_env.dataset.scene_env import make_generate_env
+
+            _ENV = make_generate_env(task, cfg.variation)
+        else:
+            _ENV = gym.make(capt_env.registration.GENERIC_ID, obs_mode="pointcloud", task=task,
+                            reconfiguration_freq=0)
         _ENV_KEY = key
     return _ENV
 
@@ -102,15 +115,31 @@ def to_json(obj: Any) -> str:
     return json.dumps(to_dict(obj), sort_keys=True)
 
 
-def _one_sample(obs: dict, info: dict, cfg: GenerateConfig, rng: np.random.Generator) -> dict | None:
-    """Cut the object out of one rendered cloud and label it; None if too few object points."""
+def _one_sample(obs: dict, info: dict, cfg: GenerateConfig, rng: np.random.Generator,
+                env: Any = None) -> dict | None:
+    """Cut the object (and any distractors) out of one rendered cloud of ``env`` and label it, with
+    the config's sensor noise; None if too few object points."""
     pc = obs["pointcloud"]
     labels = pc["part_label"].astype(np.int64)
     mask = labels >= 0
+    noise = cfg.variation.sensor_noise
+    kept = np.ones_like(mask)
+    if noise.edge_dropout > 0:
+        from capt_env.dataset.sensor_noise import edge_dropout_mask
+
+        eyes, shapes = _cameras(env)
+        kept = edge_dropout_mask(pc["xyzw"][:, :3], pc["xyzw"][:, 3] > 0, eyes, shapes, noise, rng)
+        mask &= kept
     if mask.sum() < cfg.min_object_points:
         return None
+    if cfg.variation.distractors.enabled:  # background points, part label -1
+        mask |= np.isin(pc["segmentation"].reshape(-1), env.unwrapped.distractor_segmentation_ids()) & kept
     xyz = pc["xyzw"][mask, :3].astype(np.float32)
     labels = labels[mask]
+    if noise.jitter_m > 0 or noise.outlier_fraction > 0:
+        from capt_env.dataset.sensor_noise import jitter_and_strays
+
+        xyz, labels = jitter_and_strays(xyz, labels, noise, rng)
     replace = len(xyz) < cfg.num_points
     idx = rng.choice(len(xyz), size=cfg.num_points, replace=replace)
     points, labels = xyz[idx], labels[idx]
@@ -160,7 +189,7 @@ def render_shard(cfg: GenerateConfig, job: ShardJob) -> dict[str, np.ndarray]:
                 break
             if view > 0:
                 obs, info = env.reset(seed=int(rng.integers(2**31)))
-            sample = _one_sample(obs, info, cfg, rng)
+            sample = _one_sample(obs, info, cfg, rng, env)
             if sample is None:
                 continue
             sample["instance_id"] = np.int64(iid)
@@ -174,6 +203,13 @@ def render_shard(cfg: GenerateConfig, job: ShardJob) -> dict[str, np.ndarray]:
 def _camera_eye(env: Any) -> np.ndarray:
     cam = next(iter(env.unwrapped._sensors.values())).camera
     return np.asarray(cam.get_local_pose().p, dtype=np.float32).reshape(-1)[:3]
+
+
+def _cameras(env: Any) -> tuple[list[np.ndarray], list[tuple[int, int]]]:
+    """Eye (3,) and image (height, width) of each of ``env``'s cameras, in the cloud's order."""
+    sensors = list(env.unwrapped._sensors.values())
+    eyes = [np.asarray(s.camera.get_local_pose().p, dtype=np.float64).reshape(-1)[:3] for s in sensors]
+    return eyes, [(int(s.config.height), int(s.config.width)) for s in sensors]
 
 
 def write_npz_atomic(path: Path, arrays: dict[str, np.ndarray]) -> None:
@@ -199,10 +235,19 @@ def _work(payload: tuple[str, ShardJob, str]) -> tuple[ShardJob, int]:
     return job, len(arrays["points"])
 
 
+def config_record(cfg: GenerateConfig) -> dict[str, Any]:
+    """``cfg`` as the manifest records it: without ``variation`` when nothing varies, so datasets
+    made before that option existed keep their manifest and stay resumable."""
+    data = to_dict(cfg)
+    if not cfg.variation.enabled:
+        del data["variation"]
+    return data
+
+
 def _write_manifest(out_dir: Path, cfg: GenerateConfig, extra: dict) -> None:
     from capt_common.json_report import machine_info
 
-    data = {"format": "capt-env-shards/1", "config": to_dict(cfg), "seed": cfg.seed,
+    data = {"format": "capt-env-shards/1", "config": config_record(cfg), "seed": cfg.seed,
             "versions": machine_info(), **extra}
     fd, tmp = tempfile.mkstemp(dir=out_dir, prefix="manifest", suffix=".tmp")
     with os.fdopen(fd, "w") as fh:
@@ -223,7 +268,7 @@ def generate(cfg: GenerateConfig, out_dir: str | Path, workers: int | None = Non
     manifest = out_dir / MANIFEST
     if manifest.exists():
         old = json.loads(manifest.read_text()).get("config")
-        if old != to_dict(cfg):
+        if old != config_record(cfg):
             raise ValueError(f"{out_dir} holds a dataset made with another config; use a new directory")
     else:
         _write_manifest(out_dir, cfg, {"complete": False})

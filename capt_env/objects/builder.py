@@ -1,4 +1,5 @@
-"""Build an ``ObjectSpec`` into a ManiSkill scene as an articulation (boxes -> collision + visual).
+"""Build an ``ObjectSpec`` into a ManiSkill scene as an articulation (boxes, cylinders and convex
+meshes -> the same collision and visual shape each).
 
 The simulator's joint axis is the x-axis of the joint frame, so each joint frame is placed at the
 spec's ``origin`` with the rotation taking +x onto the spec's ``axis``; since the child frame equals
@@ -21,7 +22,8 @@ import sapien.physx as physx
 from mani_skill.utils.structs import Articulation
 
 from capt_env.objects.geometry import quat_from_x_to
-from capt_env.objects.spec import ObjectSpec
+from capt_env.objects.mesh_files import convex_mesh_file
+from capt_env.objects.spec import ConvexMesh, Cylinder, LinkSpec, ObjectSpec
 
 SELF_COLLISION_BIT = 27
 """Bit of collision group 2 shared by all links of an object built here (no self-collision)."""
@@ -99,6 +101,7 @@ def build_articulated_object(
             if can_render:
                 material = sapien.render.RenderMaterial(base_color=list(box.color), roughness=0.6)
                 lb.add_box_visual(pose=box_pose, half_size=half, material=material)
+        _add_shapes(lb, link, scale, can_render, handle_mat, body_mat)
         link_builders[link.name] = lb
 
     art = builder.build(name=name, fix_root_link=fix_root)
@@ -110,6 +113,31 @@ def build_articulated_object(
         sim_joint.set_friction(joint.friction)
         sim_joint.set_drive_properties(stiffness=0.0, damping=joint.damping)
     return art
+
+
+def _add_shapes(lb: Any, link: LinkSpec, scale: float, can_render: bool, handle_mat: Any,
+                body_mat: Any) -> None:
+    """Add ``link.shapes`` (cylinders, convex meshes) to link builder ``lb``: collision and visual."""
+    for shape in link.shapes:
+        material = handle_mat if shape.is_handle else body_mat
+        look = None  # a render material needs a render system
+        if can_render:
+            look = sapien.render.RenderMaterial(base_color=list(shape.color), roughness=0.6)
+        if isinstance(shape, Cylinder):
+            pose = sapien.Pose(p=[float(v) * scale for v in shape.pos], q=list(shape.quat))
+            radius, half_length = float(shape.radius) * scale, float(shape.half_length) * scale
+            lb.add_cylinder_collision(pose=pose, radius=radius, half_length=half_length, density=link.density,
+                                      material=material)
+            if can_render:
+                lb.add_cylinder_visual(pose=pose, radius=radius, half_length=half_length, material=look)
+        elif isinstance(shape, ConvexMesh):
+            path = convex_mesh_file(shape.vertices)
+            lb.add_convex_collision_from_file(path, scale=[scale] * 3, density=link.density,
+                                              material=material)
+            if can_render:
+                lb.add_visual_from_file(path, scale=[scale] * 3, material=look)
+        else:
+            raise TypeError(f"unknown shape {type(shape).__name__} on link {link.name!r}")
 
 
 def joint_world_axis(articulation: Articulation, joint_name: str) -> tuple[np.ndarray, np.ndarray]:

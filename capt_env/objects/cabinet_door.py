@@ -10,17 +10,21 @@ Object frame: front faces -x, resting on z = 0; "left" is +y (the viewer's left 
 
 from __future__ import annotations
 
+from capt_env.objects.fronts import Front, build_front
 from capt_env.objects.geometry import opening_axis
-from capt_env.objects.parts import BODY_WHITES, WOODS, bar_handle, box_from_bounds, knob_handle, open_carcass
+from capt_env.objects.interiors import cabinet_interior
+from capt_env.objects.parts import BODY_WHITES, WOODS, box_from_bounds, open_carcass
 from capt_env.objects.sampling import ParamSampler
 from capt_env.objects.spec import JointSpec, LinkSpec, ObjectSpec, hinged_door_object
+from capt_env.objects.style import Style
 
 CATEGORY = "cabinet_door"
 GAP = 0.002  # m, around the door
 
 
-def make(instance_id: int) -> ObjectSpec:
-    """The cabinet instance ``instance_id`` (metres, radians)."""
+def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
+    """The cabinet instance ``instance_id`` (metres, radians); ``style`` varies its door, handle and
+    interior (see ``capt_env.objects.style``)."""
     s = ParamSampler(CATEGORY, instance_id)
     width = s.uniform("width", 0.28, 0.48)
     depth = s.uniform("depth", 0.25, 0.40)
@@ -56,28 +60,16 @@ def make(instance_id: int) -> ObjectSpec:
     hinge_y = sign * y1
     free_y = -sign * (y1 - handle_inset)
     zh = z0 + handle_z * (z1 - z0)
-    door_boxes = [box_from_bounds((xf - door_t, y0, z0), (xf, y1, z1), door_color)]
-    if handle_style == "bar":
-        handle, grasp = bar_handle(
-            (xf - door_t, free_y, zh),
-            normal=0,
-            normal_sign=-1.0,
-            along=2,
-            length=handle_len * (z1 - z0),
-            thickness=handle_t,
-            standoff=standoff,
-        )
-    else:
-        handle, grasp = knob_handle(
-            (xf - door_t, free_y, zh),
-            normal=0,
-            normal_sign=-1.0,
-            cap_size=0.028,
-            cap_depth=0.02,
-            standoff=standoff - 0.01,
-        )
-    door_boxes += handle
-    door = LinkSpec("door", tuple(door_boxes), density=350.0)
+    front = build_front(Front((xf - door_t, y0, z0), (xf, y1, z1), 0, -1.0, door_color,
+                              (xf - door_t, free_y, zh), along=2, handle_length=handle_len * (z1 - z0),
+                              handle_thickness=handle_t, standoff=standoff, default_handle=handle_style),
+                        style)
+    if style is not None and style.interior:
+        body += cabinet_interior(width, depth, height, wall, [height * 0.5] if shelves else [], body_color,
+                                 style.rng())
+    door = LinkSpec("door", tuple(front.panel_boxes + front.handle_boxes), density=350.0,
+                    shapes=tuple(front.shapes))
+    grasp = front.grasp
     axis = opening_axis((0.0, -sign * door_w, 0.0), (-1.0, 0.0, 0.0))
     hinge = JointSpec(
         "door_hinge",

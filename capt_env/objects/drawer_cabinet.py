@@ -10,24 +10,20 @@ Object frame: front faces -x, resting on z = 0.
 
 from __future__ import annotations
 
-from capt_env.objects.parts import (
-    BODY_WHITES,
-    METALS,
-    WOODS,
-    bar_handle,
-    box_from_bounds,
-    knob_handle,
-    open_carcass,
-)
+from capt_env.objects.fronts import Front, build_front
+from capt_env.objects.interiors import drawer_divider, drawer_frames
+from capt_env.objects.parts import BODY_WHITES, METALS, WOODS, box_from_bounds, open_carcass
 from capt_env.objects.sampling import ParamSampler
 from capt_env.objects.spec import JointSpec, LinkSpec, ObjectSpec
+from capt_env.objects.style import Style
 
 CATEGORY = "drawer_cabinet"
 GAP = 0.002  # m, between drawer fronts and around them
 
 
-def make(instance_id: int) -> ObjectSpec:
-    """The drawer-cabinet instance ``instance_id`` (metres)."""
+def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
+    """The drawer-cabinet instance ``instance_id`` (metres); ``style`` varies its fronts, handles and
+    interior (see ``capt_env.objects.style``)."""
     s = ParamSampler(CATEGORY, instance_id)
     count = s.integer("num_drawers", 1, 3)
     width = s.uniform("width", 0.30, 0.50)
@@ -51,7 +47,12 @@ def make(instance_id: int) -> ObjectSpec:
 
     height = count * slot + 2 * wall
     xf = -depth / 2
-    body = LinkSpec("body", tuple(open_carcass(width, depth, height, wall, body_color)), density=400.0)
+    body_boxes = open_carcass(width, depth, height, wall, body_color)
+    rng = style.rng() if style is not None and style.interior else None
+    if rng is not None:
+        body_boxes += drawer_frames(count, slot, wall, width, xf + front_t + 0.003, depth / 2 - wall,
+                                    body_color)
+    body = LinkSpec("body", tuple(body_boxes), density=400.0)
     links, joints, grasp = [body], [], (0.0, 0.0, 0.0)
     y0, y1 = -width / 2 + wall + GAP, width / 2 - wall - GAP
     inner_depth = depth_frac * (depth - wall - front_t)
@@ -60,40 +61,25 @@ def make(instance_id: int) -> ObjectSpec:
         z1 = wall + (i + 1) * slot - GAP
         xb = xf + front_t + inner_depth  # back of the drawer box
         zt = z0 + box_frac * (z1 - z0)
-        boxes = [
-            box_from_bounds((xf, y0, z0), (xf + front_t, y1, z1), front_color),  # front
+        zc = (z0 + z1) / 2
+        front = build_front(Front((xf, y0, z0), (xf + front_t, y1, z1), 0, -1.0, front_color, (xf, 0.0, zc),
+                                  along=1, handle_length=handle_len * (y1 - y0), handle_thickness=handle_t,
+                                  standoff=standoff, handle_color=handle_color, default_handle=handle_style),
+                            style)
+        boxes = front.panel_boxes + [
             box_from_bounds((xf + front_t, y0 + GAP, z0), (xb, y1 - GAP, z0 + side_t), inner_color),  # bottom
             box_from_bounds((xf + front_t, y0 + GAP, z0 + side_t), (xb, y0 + GAP + side_t, zt), inner_color),
             box_from_bounds((xf + front_t, y1 - GAP - side_t, z0 + side_t), (xb, y1 - GAP, zt), inner_color),
             box_from_bounds(
                 (xb - side_t, y0 + GAP + side_t, z0 + side_t), (xb, y1 - GAP - side_t, zt), inner_color
             ),
-        ]
-        zc = (z0 + z1) / 2
-        if handle_style == "bar":
-            handle, centre = bar_handle(
-                (xf, 0.0, zc),
-                normal=0,
-                normal_sign=-1.0,
-                along=1,
-                length=handle_len * (y1 - y0),
-                thickness=handle_t,
-                standoff=standoff,
-                color=handle_color,
-            )
-        else:
-            handle, centre = knob_handle(
-                (xf, 0.0, zc),
-                normal=0,
-                normal_sign=-1.0,
-                cap_size=0.028,
-                cap_depth=0.02,
-                standoff=standoff - 0.01,
-                color=handle_color,
-            )
-        boxes += handle
+        ] + front.handle_boxes
+        if rng is not None:
+            boxes += drawer_divider(xf + front_t, xb - side_t, y0 + GAP + side_t, y1 - GAP - side_t,
+                                    z0 + side_t, zt, inner_color, rng)
+        centre = front.grasp
         name = f"drawer_{i}"
-        links.append(LinkSpec(name, tuple(boxes), density=300.0))
+        links.append(LinkSpec(name, tuple(boxes), density=300.0, shapes=tuple(front.shapes)))
         joints.append(
             JointSpec(
                 f"{name}_slide",

@@ -18,13 +18,15 @@ from capt_env.objects.geometry import opening_axis
 from capt_env.objects.parts import FRAMES, GLASS, box_from_bounds
 from capt_env.objects.sampling import ParamSampler
 from capt_env.objects.spec import Box, JointSpec, LinkSpec, ObjectSpec
+from capt_env.objects.style import Style
 
 CATEGORY = "eyeglasses"
 GAP = 0.002  # m, between the front and the folded temples, and between the temples
 
 
-def make(instance_id: int) -> ObjectSpec:
-    """The eyeglasses instance ``instance_id`` (metres, radians)."""
+def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
+    """The eyeglasses instance ``instance_id`` (metres, radians); ``style`` changes nothing (thin
+    frames have no panel, handle or interior to vary)."""
     s = ParamSampler(CATEGORY, instance_id)
     lens_w = s.uniform("lens_width", 0.075, 0.1)
     lens_h = s.uniform("lens_height", 0.045, 0.07)

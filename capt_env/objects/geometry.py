@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from capt_env.objects.spec import Box
+from capt_env.objects.spec import Box, Cylinder, Shape
 
 _CORNER_SIGNS = np.array([[sx, sy, sz] for sx in (-1.0, 1.0) for sy in (-1.0, 1.0) for sz in (-1.0, 1.0)])
 
@@ -71,6 +71,17 @@ def box_corners(box: Box) -> np.ndarray:
     """(8, 3) corners of ``box`` in its link's frame, metres."""
     local = _CORNER_SIGNS * np.asarray(box.half_size, dtype=np.float64)
     return local @ quat_to_matrix(box.quat).T + np.asarray(box.pos, dtype=np.float64)
+
+
+def shape_points(shape: Shape, count: int = 16) -> np.ndarray:
+    """Points (M, 3) whose convex hull is ``shape`` (a mesh's vertices; for a cylinder, ``count``
+    points on each end circle, a hull slightly inside the true one), link frame, metres."""
+    if isinstance(shape, Cylinder):
+        t = np.linspace(0.0, 2 * np.pi, count, endpoint=False)
+        ring = np.stack([np.zeros(count), shape.radius * np.cos(t), shape.radius * np.sin(t)], axis=-1)
+        local = np.concatenate([ring + [shape.half_length, 0, 0], ring - [shape.half_length, 0, 0]])
+        return local @ quat_to_matrix(shape.quat).T + np.asarray(shape.pos, dtype=np.float64)
+    return np.asarray(shape.vertices, dtype=np.float64).reshape(-1, 3)
 
 
 def rotate_about_axis(

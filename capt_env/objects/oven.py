@@ -8,16 +8,20 @@ Object frame: front faces -x, resting on z = 0.
 
 from __future__ import annotations
 
+from capt_env.objects.fronts import Front, build_front
 from capt_env.objects.geometry import opening_axis
-from capt_env.objects.parts import BODY_WHITES, GLASS, METALS, bar_handle, box_from_bounds, open_carcass
+from capt_env.objects.interiors import oven_racks
+from capt_env.objects.parts import BODY_WHITES, GLASS, METALS, box_from_bounds, open_carcass
 from capt_env.objects.sampling import ParamSampler
 from capt_env.objects.spec import JointSpec, LinkSpec, ObjectSpec, hinged_door_object
+from capt_env.objects.style import Style
 
 CATEGORY = "oven"
 
 
-def make(instance_id: int) -> ObjectSpec:
-    """The oven instance ``instance_id`` (metres, radians)."""
+def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
+    """The oven instance ``instance_id`` (metres, radians); ``style`` varies its door, handle and
+    interior (see ``capt_env.objects.style``)."""
     s = ParamSampler(CATEGORY, instance_id)
     width = s.uniform("width", 0.40, 0.56)
     depth = s.uniform("depth", 0.33, 0.48)
@@ -60,25 +64,23 @@ def make(instance_id: int) -> ObjectSpec:
     z0, z1 = plinth, height - panel
     y0, y1 = -width / 2 + side_gap, width / 2 - side_gap
     door_h = z1 - z0
-    door_boxes = [box_from_bounds((xf - door_t, y0, z0), (xf, y1, z1), door_color)]
     wh, ww = window_frac * door_h, 0.75 * (y1 - y0)
     zc = z0 + 0.45 * door_h
-    door_boxes.append(
-        box_from_bounds(
-            (xf - door_t - 0.002, -ww / 2, zc - wh / 2), (xf - door_t + 0.001, ww / 2, zc + wh / 2), glass
-        )
+    glass_box = box_from_bounds(
+        (xf - door_t - 0.002, -ww / 2, zc - wh / 2), (xf - door_t + 0.001, ww / 2, zc + wh / 2), glass
     )
-    handle, grasp = bar_handle(
-        (xf - door_t, 0.0, z1 - handle_inset - handle_t / 2),
-        normal=0,
-        normal_sign=-1.0,
-        along=1,
-        length=handle_len * (y1 - y0),
-        thickness=handle_t,
-        standoff=standoff,
-    )
-    door_boxes += handle
-    door = LinkSpec("door", tuple(door_boxes), density=250.0)
+    front = build_front(Front((xf - door_t, y0, z0), (xf, y1, z1), 0, -1.0, door_color,
+                              (xf - door_t, 0.0, z1 - handle_inset - handle_t / 2), along=1,
+                              handle_length=handle_len * (y1 - y0), handle_thickness=handle_t,
+                              standoff=standoff),
+                        style)
+    # the window lies on a flat face (none on a curved door or one cut for a recessed pull)
+    flat = style is None or (style.panel != "curved" and style.handle != "recessed")
+    door_boxes = front.panel_boxes + ([glass_box] if flat else []) + front.handle_boxes
+    if style is not None and style.interior:
+        body += oven_racks(width, depth, wall, height - wall, wall, METALS[0] + (1.0,), style.rng())
+    door = LinkSpec("door", tuple(door_boxes), density=250.0, shapes=tuple(front.shapes))
+    grasp = front.grasp
     axis = opening_axis((0.0, 0.0, door_h), (-1.0, 0.0, 0.0))  # top edge towards -x: -y
     hinge = JointSpec(
         "door_hinge",

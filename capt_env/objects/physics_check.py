@@ -14,18 +14,21 @@ import torch
 from capt_env.objects.builder import build_articulated_object
 from capt_env.objects.registry import make_object
 from capt_env.objects.scene import create_scene
+from capt_env.objects.style import GeometryVariation
 
 OPEN_TORQUE = 2.0  # N m, revolute
 OPEN_FORCE = 10.0  # N, prismatic
 
 
 def probe(
-    category: str, instance_id: int, seconds: float = 1.0, start_fraction: float = 0.3
+    category: str, instance_id: int, seconds: float = 1.0, start_fraction: float = 0.3,
+    variation: GeometryVariation | None = None,
 ) -> dict[str, float]:
     """Fractions of the target joint's range moved in ``seconds`` from ``start_fraction`` of it:
-    ``idle`` under gravity alone, ``pushed`` with a constant opening torque/force on the joint."""
+    ``idle`` under gravity alone, ``pushed`` with a constant opening torque/force on the joint.
+    ``variation`` varies the instance's geometry (``capt_env.objects.style``)."""
     scene = create_scene(render=False)
-    spec = make_object(category, instance_id)
+    spec = make_object(category, instance_id, variation)
     k = spec.joint_index(spec.target_joint)
     joint = spec.joints[k]
     lo, hi = joint.limits

@@ -1,6 +1,8 @@
-"""Simulator-independent description of an articulated object: links made of boxes, 1-DoF joints.
+"""Simulator-independent description of an articulated object: links made of boxes (and, for varied
+geometry, cylinders and convex meshes), 1-DoF joints.
 
-Frames: every link has its own frame; a box's ``pos``/``quat`` are in its link's frame. A joint's
+Frames: every link has its own frame; a shape's ``pos``/``quat`` (or a mesh's vertices) are in its
+link's frame. A joint's
 ``origin``/``axis`` are given in the PARENT link's frame at joint state 0, and at state 0 the child
 frame coincides with the parent frame (so child geometry is written in the same coordinates as the
 parent's at the closed/zero pose). The object frame is the base link's frame: +z up, the object rests
@@ -34,12 +36,41 @@ class Box:
 
 
 @dataclass(frozen=True)
+class Cylinder:
+    """A solid cylinder along its own x-axis (SAPIEN's convention): ``radius`` and ``half_length``
+    metres, pose in its link frame."""
+
+    radius: float
+    half_length: float
+    pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    quat: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    color: tuple[float, float, float, float] = (0.7, 0.7, 0.7, 1.0)
+    is_handle: bool = False
+
+
+@dataclass(frozen=True)
+class ConvexMesh:
+    """The convex hull of ``vertices`` (each (3,), metres, link frame): rounded, chamfered and curved
+    panels. Collision and visual shape are the same hull."""
+
+    vertices: tuple[tuple[float, float, float], ...]
+    color: tuple[float, float, float, float] = (0.7, 0.7, 0.7, 1.0)
+    is_handle: bool = False
+
+
+Shape = Cylinder | ConvexMesh
+"""The non-box shapes a link may carry (``LinkSpec.shapes``)."""
+
+
+@dataclass(frozen=True)
 class LinkSpec:
-    """A rigid part. ``density`` in kg/m^3 sets the mass from the boxes' volume."""
+    """A rigid part. ``density`` in kg/m^3 sets the mass from the shapes' volume. ``shapes`` holds
+    the non-box geometry (empty for every category's default instances)."""
 
     name: str
     boxes: tuple[Box, ...]
     density: float = 300.0
+    shapes: tuple[Shape, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -94,25 +125,27 @@ class ObjectSpec:
         )
 
     def aabb(self) -> tuple[np.ndarray, np.ndarray]:
-        """Axis-aligned bounds (min, max) of all boxes at state 0, object frame, metres."""
-        from capt_env.objects.geometry import box_corners
+        """Axis-aligned bounds (min, max) of all shapes at state 0, object frame, metres."""
+        from capt_env.objects.geometry import box_corners, shape_points
 
-        pts = np.concatenate([box_corners(b) for link in self.links for b in link.boxes])
+        pts = np.concatenate([box_corners(b) for link in self.links for b in link.boxes]
+                             + [shape_points(s) for link in self.links for s in link.shapes])
         return pts.min(axis=0), pts.max(axis=0)
 
 
 def hinged_door_object(category: str, instance_id: int, body: Iterable[Box], door: LinkSpec, hinge: JointSpec,
-                       grasp_point: tuple[float, float, float], params: dict) -> ObjectSpec:
-    """An instance made of a fixed body (``body`` boxes, 400 kg/m^3) and one ``door`` link on the
-    revolute joint ``hinge`` (body to door), which is the target; ``grasp_point`` is in the door's
-    frame, metres (an oven, a washing machine, a cabinet door)."""
+                       grasp_point: tuple[float, float, float], params: dict,
+                       body_shapes: Iterable[Shape] = ()) -> ObjectSpec:
+    """An instance made of a fixed body (``body`` boxes and ``body_shapes``, 400 kg/m^3) and one
+    ``door`` link on the revolute joint ``hinge`` (body to door), which is the target;
+    ``grasp_point`` is in the door's frame, metres (an oven, a washing machine, a cabinet door)."""
     if hinge.parent != "body" or hinge.child != door.name:
         raise ValueError(f"the hinge must join 'body' to {door.name!r}, "
                          f"got {hinge.parent!r} -> {hinge.child!r}")
     return ObjectSpec(
         category,
         instance_id,
-        (LinkSpec("body", tuple(body), density=400.0), door),
+        (LinkSpec("body", tuple(body), density=400.0, shapes=tuple(body_shapes)), door),
         (hinge,),
         target_joint=hinge.name,
         grasp_link=door.name,

@@ -326,7 +326,11 @@ def spec_to_urdf(spec: ObjectSpec, robot_name: str | None = None) -> str:
 
     A spec's link frames all coincide at state 0, while a URDF child frame sits at its joint's
     origin, so each link's geometry is written relative to its own joint's pivot (object frame
-    offsets; every frame keeps the object frame's orientation)."""
+    offsets; every frame keeps the object frame's orientation). Specs with varied geometry (cylinders,
+    convex meshes) are refused."""
+    if any(link.shapes for link in spec.links):
+        raise ValueError(f"{spec.category} #{spec.instance_id} has non-box shapes (varied geometry); "
+                         "spec_to_urdf writes boxes only")
     name = robot_name or f"{spec.category}_{spec.instance_id}"
     offset = {spec.links[0].name: np.zeros(3)}
     offset.update({j.child: np.asarray(j.origin, dtype=np.float64) for j in spec.joints})

@@ -12,24 +12,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from capt_env.objects.fronts import Front, Panel, build_front
 from capt_env.objects.geometry import opening_axis, quat_from_axis_angle
-from capt_env.objects.parts import (
-    BODY_WHITES,
-    GLASS,
-    METALS,
-    bar_handle,
-    box_from_bounds,
-    knob_handle,
-    open_carcass,
-)
+from capt_env.objects.interiors import drum
+from capt_env.objects.parts import BODY_WHITES, GLASS, METALS, box_from_bounds, open_carcass
 from capt_env.objects.sampling import ParamSampler
 from capt_env.objects.spec import Box, JointSpec, LinkSpec, ObjectSpec, hinged_door_object
+from capt_env.objects.style import Style
 
 CATEGORY = "washing_machine"
 
 
-def make(instance_id: int) -> ObjectSpec:
-    """The washing machine instance ``instance_id`` (metres, radians)."""
+def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
+    """The washing machine instance ``instance_id`` (metres, radians); ``style`` varies its door,
+    handle and interior (see ``capt_env.objects.style``)."""
     s = ParamSampler(CATEGORY, instance_id)
     width = s.uniform("width", 0.38, 0.52)
     depth = s.uniform("depth", 0.34, 0.48)
@@ -67,10 +63,9 @@ def make(instance_id: int) -> ObjectSpec:
     size = hole + 2 * overlap
     half = size / 2
     x0, x1 = xf - door_t, xf
-    if shape == "square":
-        door_boxes = [box_from_bounds((x0, -half, zc - half), (x1, half, zc + half), door_color)]
-    else:  # a plus of two slabs and a diamond: a round-ish outline
-        door_boxes = [
+    own_panel = None
+    if shape == "round" and (style is None or not style.cylinders):  # a plus of two slabs and a diamond
+        own_panel = Panel([
             box_from_bounds((x0, -half, zc - 0.62 * half), (x1, half, zc + 0.62 * half), door_color),
             box_from_bounds((x0, -0.62 * half, zc - half), (x1, 0.62 * half, zc + half), door_color),
             Box(
@@ -79,34 +74,29 @@ def make(instance_id: int) -> ObjectSpec:
                 quat=tuple(float(v) for v in quat_from_axis_angle((1.0, 0.0, 0.0), np.pi / 4)),
                 color=door_color,
             ),
-        ]
+        ], [], lambda p: 0.0, 0.005)
     glass_r = 0.55 * half
-    door_boxes.append(
-        box_from_bounds((x0 - 0.004, -glass_r, zc - glass_r), (x0 + 0.001, glass_r, zc + glass_r), glass)
-    )
+    glass_box = box_from_bounds((x0 - 0.004, -glass_r, zc - glass_r), (x0 + 0.001, glass_r, zc + glass_r),
+                                glass)
     sign = 1.0 if side == "left" else -1.0  # the hinge edge is at y = sign * half
     free_y = -sign * (half - max(0.035, 0.25 * half))
-    if handle_style == "bar":
-        handle, grasp = bar_handle(
-            (x0, free_y, zc),
-            normal=0,
-            normal_sign=-1.0,
-            along=2,
-            length=handle_len * size,
-            thickness=handle_t,
-            standoff=standoff,
-        )
-    else:
-        handle, grasp = knob_handle(
-            (x0, free_y, zc),
-            normal=0,
-            normal_sign=-1.0,
-            cap_size=0.03,
-            cap_depth=0.02,
-            standoff=standoff - 0.01,
-        )
-    door_boxes += handle
-    door = LinkSpec("door", tuple(door_boxes), density=300.0)
+    front = build_front(Front((x0, -half, zc - half), (x1, half, zc + half), 0, -1.0, door_color,
+                              (x0, free_y, zc), along=2, handle_length=handle_len * size,
+                              handle_thickness=handle_t, standoff=standoff, default_handle=handle_style,
+                              knob_size=0.03, round=shape == "round"),
+                        style, own_panel)
+    # the window lies on a flat face (none on a curved door or one cut for a recessed pull)
+    flat = style is None or (style.panel != "curved" and style.handle != "recessed")
+    door_boxes = front.panel_boxes + ([glass_box] if flat else []) + front.handle_boxes
+    body_shapes = []
+    if style is not None and style.interior:
+        r_max = min(width / 2 - wall, zc - wall, height - wall - zc) - 0.006
+        slats, back = drum(xf + wall + 0.003, depth / 2 - wall - 0.01, zc, min(hole / 2 + 0.01, r_max),
+                           METALS[0] + (1.0,), style.rng())
+        body += slats
+        body_shapes += back
+    door = LinkSpec("door", tuple(door_boxes), density=300.0, shapes=tuple(front.shapes))
+    grasp = front.grasp
     axis = opening_axis((0.0, -sign * size, 0.0), (-1.0, 0.0, 0.0))
     hinge = JointSpec(
         "door_hinge",
@@ -119,4 +109,4 @@ def make(instance_id: int) -> ObjectSpec:
         damping=1.0,
         friction=0.04,
     )
-    return hinged_door_object(CATEGORY, instance_id, body, door, hinge, grasp, s.params)
+    return hinged_door_object(CATEGORY, instance_id, body, door, hinge, grasp, s.params, body_shapes)

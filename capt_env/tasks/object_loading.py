@@ -127,11 +127,12 @@ def _joint_table(art: Articulation) -> JointTable:
 
 
 def load_procedural(scene: Any, cfg: TaskConfig, instance_id: int, name: str = "object",
-                    scene_idxs: list[int] | None = None) -> LoadedObject:
+                    scene_idxs: list[int] | None = None, spec: ObjectSpec | None = None) -> LoadedObject:
     """Build instance ``instance_id`` of ``cfg.category`` as articulation ``name`` (unique in the
-    scene) in the sub-scenes ``scene_idxs`` (default: all) and describe it."""
+    scene) in the sub-scenes ``scene_idxs`` (default: all) and describe it. ``spec`` replaces the
+    instance's own spec (one with varied geometry, see ``capt_env.objects.style``)."""
     iid = int(instance_id)
-    spec = make_object(cfg.category, iid)
+    spec = spec if spec is not None else make_object(cfg.category, iid)
     art = build_articulated_object(scene, spec, name=name, fix_root=True, scale=cfg.scale,
                                    scene_idxs=scene_idxs)
     joints, names, type_ids, sim_limits, child_parts = _joint_table(art)

@@ -1,0 +1,100 @@
+"""Varied geometry of the procedural categories: which options are on (:class:`GeometryVariation`, the
+``variation.geometry`` keys of ``capt generate``) and one instance's drawn choices (:class:`Style`).
+
+An instance's style is a pure function of (category, instance_id), like its shape parameters, but it
+is drawn from a generator of its own (:func:`draw_style`): turning variation on changes none of the
+base parameters (sizes, hinge side, joint limits, colours), an instance stays in its split, and every
+choice is drawn whatever the options, so turning one option on changes no other option's draws.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from capt_env.objects.sampling import category_seed, check_instance_id
+
+PanelShape = Literal["box", "rounded", "chamfered", "curved"]
+HandleKind = Literal["bar", "knob", "recessed", "lever"]
+PANEL_SHAPES: tuple[PanelShape, ...] = ("box", "rounded", "chamfered", "curved")
+HANDLE_KINDS: tuple[HandleKind, ...] = ("bar", "knob", "recessed", "lever")
+_STYLE_STREAM = 7_411  # keeps the style generator apart from the shape parameters' one
+
+
+@dataclass(frozen=True)
+class GeometryVariation:
+    """Which geometry options vary per instance (all off: every instance as the category makes it).
+
+    - ``panels``: the moving panel (door, drawer front, laptop lid, and a laptop's base) is a box,
+      a rounded panel (corners rounded in the panel's plane, radius 10-40 % of half its smaller side),
+      a chamfered one (outer edges bevelled at 45 degrees by 30-70 % of its thickness, at most
+      1.5 cm) or a curved one (outer face bowed out along its longer side by 1-3 cm, at most 15 % of
+      that side), a quarter of the instances each; half of the instances build round parts as
+      cylinders (a washing machine's round door, bars, posts and knobs).
+    - ``handles``: each instance's handle is a bar, a knob, a recessed pull (a pocket 2.8 cm high
+      cut 60 % into a flat panel; the grasp point is the pocket's centre) or a lever (a stem and a
+      bar to one side), a quarter each; bars and levers lie along one of the panel's two axes on
+      half of the instances and at a uniform angle in (-pi/2, pi/2) radians on the others. A laptop
+      with a recessed pull has no lip. Eyeglasses keep their ear pieces.
+    - ``interiors``: inner structure of the base, seen when the part is open: one or two extra
+      shelves and a divider in a cabinet, one or two wire racks in an oven, a drum of slats in a
+      washing machine, frames between the drawers of a drawer cabinet and a divider in each drawer
+      (that one moves with its drawer).
+    """
+
+    panels: bool = False
+    handles: bool = False
+    interiors: bool = False
+
+    @property
+    def enabled(self) -> bool:
+        """True when any option is on."""
+        return self.panels or self.handles or self.interiors
+
+
+@dataclass(frozen=True)
+class Style:
+    """One instance's geometry choices (see :class:`GeometryVariation`). ``panel_size`` in [0, 1)
+    places the panel shape's size within its range; ``handle`` None keeps the category's own kind;
+    ``handle_angle`` (radians) turns bars and levers in the panel plane from the category's bar
+    direction; ``seed`` draws the interior's details (:meth:`rng`)."""
+
+    panel: PanelShape = "box"
+    panel_size: float = 0.0
+    cylinders: bool = False
+    handle: HandleKind | None = None
+    handle_angle: float = 0.0
+    interior: bool = False
+    seed: int = 0
+
+    def rng(self) -> np.random.Generator:
+        """A fresh generator for the interior's details (the same every call)."""
+        return np.random.default_rng([self.seed, _STYLE_STREAM])
+
+
+def draw_style(category: str, instance_id: int, variation: GeometryVariation) -> Style | None:
+    """Instance ``instance_id``'s style under ``variation``; None when every option is off."""
+    check_instance_id(category, instance_id)
+    if not variation.enabled:
+        return None
+    rng = np.random.default_rng([category_seed(category), int(instance_id), _STYLE_STREAM])
+    panel = PANEL_SHAPES[int(rng.integers(len(PANEL_SHAPES)))]
+    size = float(rng.random())
+    cylinders = bool(rng.random() < 0.5)
+    kind = HANDLE_KINDS[int(rng.integers(len(HANDLE_KINDS)))]
+    aligned = bool(rng.random() < 0.5)
+    turned = float(rng.uniform(-math.pi / 2, math.pi / 2))
+    angle = float(rng.choice([0.0, math.pi / 2])) if aligned else turned
+    seed = int(rng.integers(2**31))
+    return Style(
+        panel=panel if variation.panels else "box",
+        panel_size=size,
+        cylinders=cylinders and variation.panels,
+        handle=kind if variation.handles else None,
+        handle_angle=angle if variation.handles else 0.0,
+        interior=variation.interiors,
+        seed=seed,
+    )

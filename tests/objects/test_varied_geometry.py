@@ -1,0 +1,115 @@
+"""Varied geometry (``capt_env.objects.style``): default instances unchanged, varied ones sound (base
+parameters kept, handles hold the grasp point, shapes build, physics sane)."""
+
+from __future__ import annotations
+
+import hashlib
+from collections import Counter
+
+import numpy as np
+import pytest
+
+from capt_env.objects.geometry import quat_to_matrix
+from capt_env.objects.physics_check import probe
+from capt_env.objects.registry import CATEGORIES, make_object
+from capt_env.objects.spec import Box, ConvexMesh, Cylinder
+from capt_env.objects.style import GeometryVariation, draw_style
+
+ALL = GeometryVariation(panels=True, handles=True, interiors=True)
+
+# sha256[:16] of the specs of instances 0, 7, ..., 994 of every category, computed before varied
+# geometry existed (the repr of each spec with the then-absent ``shapes=()`` removed)
+DEFAULT_SPEC_HASHES = {
+    "laptop": "d9ae6a9c67ee37d8",
+    "oven": "3baa641e5d24cef5",
+    "washing_machine": "cb9ae74dde9afb82",
+    "eyeglasses": "48d48b6aee1edbe8",
+    "drawer_cabinet": "418fb759177537b4",
+    "cabinet_door": "3217e2ce16603e43",
+}
+
+
+@pytest.mark.parametrize("category", CATEGORIES)
+def test_default_instances_are_those_made_before_variation(category: str) -> None:
+    h = hashlib.sha256()
+    for i in range(0, 1000, 7):
+        s = make_object(category, i)
+        assert make_object(category, i, GeometryVariation()) == s
+        key = (s.links, s.joints, s.target_joint, s.grasp_link, s.grasp_point, s.front)
+        h.update(repr(key).replace(", shapes=()", "").encode())
+    assert h.hexdigest()[:16] == DEFAULT_SPEC_HASHES[category]
+
+
+def _inside(point: np.ndarray, shape: Box | Cylinder, tol: float = 1e-6) -> bool:
+    local = (point - np.asarray(shape.pos)) @ quat_to_matrix(shape.quat)
+    if isinstance(shape, Box):
+        return bool(np.all(np.abs(local) <= np.asarray(shape.half_size) + tol))
+    return abs(local[0]) <= shape.half_length + tol and np.hypot(local[1], local[2]) <= shape.radius + tol
+
+
+@pytest.mark.parametrize("category", CATEGORIES)
+def test_varied_instances_keep_base_parameters_and_hold_the_grasp_point(category: str) -> None:
+    for i in range(0, 1000, 37):
+        plain, varied = make_object(category, i), make_object(category, i, ALL)
+        style = draw_style(category, i, ALL)
+        assert varied.joints == plain.joints and varied.params == plain.params
+        assert [link.name for link in varied.links] == [link.name for link in plain.links]
+        lo, hi = varied.aabb()
+        assert abs(lo[2]) < 1e-9 and float(np.max(hi - lo)) < 0.7
+        link = varied.links[varied.link_index(varied.grasp_link)]
+        grasp = np.asarray(varied.grasp_point)
+        pieces = [*link.boxes, *(s for s in link.shapes if isinstance(s, Cylinder))]
+        if category == "eyeglasses" or style.handle != "recessed":
+            assert any(p.is_handle and _inside(grasp, p) for p in pieces), f"{category} #{i} {style}"
+        elif category == "laptop":  # no lip: the lid's front edge
+            assert not any(b.is_handle for b in link.boxes)
+            assert abs(grasp[0] - plain.aabb()[0][0] - 0.0) < 0.04
+        else:  # the pocket: in no piece, with its floor (a handle box) just behind
+            assert not any(_inside(grasp, p) for p in pieces)
+            floor = [b for b in link.boxes if b.is_handle]
+            behind = np.array([floor[0].pos[0], grasp[1], grasp[2]])  # fronts face -x
+            assert len(floor) == 1 and floor[0].pos[0] > grasp[0] and _inside(behind, floor[0], tol=0.0)
+
+
+def test_each_option_varies_what_it_names() -> None:
+    only = {name: GeometryVariation(**{name: True}) for name in ("panels", "handles", "interiors")}
+    ids = range(0, 1000, 25)
+    shapes = Counter(type(s).__name__ for i in ids for link in make_object("oven", i, only["panels"]).links
+                     for s in link.shapes)
+    assert shapes["ConvexMesh"] > 0 and shapes["Cylinder"] > 0  # shaped panels, cylindrical bars
+    kinds = Counter(draw_style("drawer_cabinet", i, only["handles"]).handle for i in ids)
+    assert set(kinds) == {"bar", "knob", "recessed", "lever"}
+    assert all(draw_style("drawer_cabinet", i, only["handles"]).panel == "box" for i in ids)
+    for category in ("oven", "washing_machine", "drawer_cabinet", "cabinet_door"):
+        plain = make_object(category, 3)
+        inner = make_object(category, 3, only["interiors"])
+        assert len(inner.links[0].boxes) > len(plain.links[0].boxes), category
+        assert inner.links[1:] == plain.links[1:] or category == "drawer_cabinet"
+
+
+@pytest.mark.parametrize("category", CATEGORIES)
+def test_varied_parts_neither_swing_nor_stick(category: str) -> None:
+    for instance_id in range(0, 1000, 90):
+        moved = probe(category, instance_id, seconds=1.0, start_fraction=0.3, variation=ALL)
+        assert abs(moved["idle"]) < 0.05, (instance_id, moved)
+        assert moved["pushed"] > 0.08, (instance_id, moved)
+
+
+def test_varied_shapes_build_with_collision_shapes() -> None:
+    import sapien.physx as px
+
+    from capt_env.objects.builder import build_articulated_object
+    from capt_env.objects.scene import create_scene
+
+    scene = create_scene(render=False)
+    for k, (category, iid) in enumerate((("washing_machine", 3), ("drawer_cabinet", 4), ("oven", 1))):
+        spec = make_object(category, iid, ALL)
+        art = build_articulated_object(scene, spec, name=f"varied_{k}")
+        for link, built in zip(spec.links, art.links, strict=True):
+            shapes = built._objs[0].get_collision_shapes()
+            assert len(shapes) == len(link.boxes) + len(link.shapes)
+            kinds = {type(s) for s in shapes}
+            if any(isinstance(s, ConvexMesh) for s in link.shapes):
+                assert px.PhysxCollisionShapeConvexMesh in kinds
+            if any(isinstance(s, Cylinder) for s in link.shapes):
+                assert px.PhysxCollisionShapeCylinder in kinds
