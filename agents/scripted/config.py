@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from capt_common.typed_yaml import require
 
 
@@ -19,7 +21,15 @@ class ScriptedOpenerConfig:
     it starts nearer level) and ``prismatic_approach_pitch`` for drawers; a level Panda hand near the
     table is beyond its wrist limits. A drawer's handle 8 cm above the table, approached 0.55 rad
     down, ran wrist joint 5 into its limit short of the grasp orientation, and the tilted fingers
-    squeezed the bar out (drawer seeds 38, 41, 94, 133, 157, 162; 0.3 rad opened them). The hand first
+    squeezed the bar out (drawer seeds 38, 41, 94, 133, 157, 162; 0.3 rad opened them). A prismatic
+    part whose axis lies more than ``slide_across_min_angle`` rad from the horizontal direction to the
+    robot's base slides across its face (a window sliding up, a sliding door): the hand approaches
+    that face square on from the robot's side, ``approach_pitch`` rad down, the fingers closing along
+    the slide, and pulls along the axis whatever way it points
+    (:func:`~agents.scripted.grasp_pose.slides_across_face`); a part whose axis points nearer the
+    robot comes out of its face like a drawer. A prismatic part whose opening direction rises more
+    than ``hold_rising_above`` rad above horizontal (a window sliding up) is held where the pull
+    ended, not let go: gravity slides it back closed (0: off). The hand first
     turns in place to the grasp orientation while it is more than ``rotate_first_above`` rad from it, for
     at most ``rotate_first_steps`` steps (turned while travelling, the arm's IK reaches a low, far handle
     with the wrist at its joint limit and cannot hold the pose while pulling; 0 steps: never). The grasp
@@ -89,8 +99,14 @@ class ScriptedOpenerConfig:
     backs off ``retreat_distance`` m. With ``regrasp_other_fingers``, fingers that close on nothing (gap
     below ``hold_gap``; not a lid's) open, back off and grasp again with the fingers the other way round
     (a re-grasp): for a low handle one of the two finger orders can leave a wrist joint at its limit short
-    of the handle. A pull that stalls with one of the Panda's wrist joints (5, 6, 7) within
-    ``wrist_limit_margin`` rad of its limit (0: off) grasps again that way too: the arm ran out of range
+    of the handle. With ``quarter_turn``, that is so only when the approach timed out (``move_timeout``)
+    or a wrist joint is within ``wrist_limit_margin`` of its limit as the fingers close; otherwise the
+    hand reached the handle (its goal, or blocked by touching it) and the handle does not lie across
+    the fingers (a lever bar at right angles to a door's hinge, where the fingers close along the
+    radius for a bar parallel to it), so this and later grasps turn the fingers a quarter turn about
+    the approach (each such miss turns them back). A pull that stalls with one of the Panda's wrist
+    joints (5, 6, 7) within ``wrist_limit_margin`` rad of its limit (0: off) grasps again that way
+    too: the arm ran out of range
     with this finger order (oven doors), and grasping again the same way returns it to the same limit.
     A door that gravity opens further once let go (hinged below its grasp point about a non-vertical
     axis and not a lid: an oven door) is not grasped again once the pull ends (stall or slip) past
@@ -145,6 +161,8 @@ class ScriptedOpenerConfig:
     grasp_depth: float = 0.01
     approach_pitch: float = 0.55
     prismatic_approach_pitch: float = 0.3
+    slide_across_min_angle: float = 0.785
+    hold_rising_above: float = 0.3
     vertical_hinge_pitch: float = 0.8
     vertical_hinge_max_tilt: float = 0.8
     rotate_first_above: float = 0.4
@@ -191,6 +209,7 @@ class ScriptedOpenerConfig:
     limit_min_speed_m: float = 0.005
     max_regrasps: int = 2
     regrasp_other_fingers: bool = True
+    quarter_turn: bool = True
     wrist_limit_margin: float = 0.05
     retreat_distance: float = 0.08
     fall_open_done: float = 1.3
@@ -263,6 +282,11 @@ class ScriptedOpenerConfig:
                 f"fall_open_done must be >= 0 rad (0: off), got {self.fall_open_done}")
         require(self.revolute_stop_above >= 0,
                 f"revolute_stop_above must be >= 0 rad (0: off), got {self.revolute_stop_above}")
+        require(0.0 <= self.slide_across_min_angle <= np.pi,
+                f"slide_across_min_angle must be in [0, pi] rad (past pi/2: never), "
+                f"got {self.slide_across_min_angle}")
+        require(0.0 <= self.hold_rising_above <= 1.5,
+                f"hold_rising_above must be in [0, 1.5] rad (0: off), got {self.hold_rising_above}")
         require(self.prismatic_stop_above >= 0,
                 f"prismatic_stop_above must be >= 0 m (0: off), got {self.prismatic_stop_above}")
         require(self.settle_above >= 0, f"settle_above must be >= 0 rad, got {self.settle_above}")

@@ -26,6 +26,36 @@ def outward_normal(est: JointAxisEstimate) -> np.ndarray:
     return unit(np.cross(u, est.grasp_point - est.pivot))
 
 
+def slides_across_face(est: JointAxisEstimate, cfg: ScriptedOpenerConfig,
+                       robot_side: np.ndarray | None) -> bool:
+    """Whether ``est`` is a prismatic part that slides across the face its handle is on (a window
+    sliding up, a sliding door sliding sideways) rather than out of it towards the hand (a drawer):
+    its axis is more than ``slide_across_min_angle`` rad from ``robot_side`` (3,), the horizontal
+    direction from the grasp point to the robot's base. The robot sees and reaches the object from
+    that side, so a handle stands off the face turned to it; a part whose axis points there comes out
+    of that face, one whose axis lies across it slides in it. False without ``robot_side``."""
+    if est.joint_type != "prismatic" or robot_side is None:
+        return False
+    side = perpendicular(UP, np.asarray(robot_side, dtype=np.float64))
+    if side is None:
+        return False
+    return float(unit(est.direction) @ side) < float(np.cos(cfg.slide_across_min_angle))
+
+
+def approach_normal(est: JointAxisEstimate, cfg: ScriptedOpenerConfig,
+                    robot_side: np.ndarray | None = None) -> np.ndarray:
+    """World unit direction (3,) out of the face the hand grips, which it approaches against: the
+    :func:`outward_normal`, except for a part that :func:`slides_across_face`, whose handle stands off
+    its face towards the robot: there, the part of ``robot_side`` across the axis (the hand comes
+    at the face square on, whatever direction the part then slides in)."""
+    if slides_across_face(est, cfg, robot_side):
+        assert robot_side is not None
+        face = perpendicular(unit(est.direction), perpendicular(UP, np.asarray(robot_side, dtype=np.float64)))
+        if face is not None:
+            return face
+    return outward_normal(est)
+
+
 def is_vertical_hinge(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
     """Whether ``est`` is a revolute joint whose axis is within ``vertical_hinge_max_tilt`` of vertical."""
     if est.joint_type != "revolute":
@@ -96,12 +126,15 @@ def lift_pose(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerCo
     return est.grasp_point + ahead * front - cfg.lid_lift_below * up, rot
 
 
-def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig) -> np.ndarray:
-    """TCP rotation (3, 3) for grasping: approach along -n, fingers closing across the handle.
+def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig,
+                   robot_side: np.ndarray | None = None) -> np.ndarray:
+    """TCP rotation (3, 3) for grasping: approach along -n (:func:`approach_normal`; ``robot_side``
+    (3,) is the direction from the grasp point to the robot's base), fingers closing across the
+    handle.
 
     Of the two finger orientations (closing c or -c) the one nearer ``current`` is chosen.
     """
-    n = outward_normal(est)
+    n = approach_normal(est, cfg, robot_side)
     approach = -n
     if is_lid(est, cfg):
         # a part lying flat and opening upwards (a lid): along the radius one finger would come down
@@ -109,6 +142,10 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
         closing = perpendicular(approach, unit(est.direction))
     elif est.joint_type == "revolute":
         closing = perpendicular(approach, est.grasp_point - est.pivot)
+    elif slides_across_face(est, cfg, robot_side):
+        # the fingers close along the slide: one pad pushes the handle the way the part moves,
+        # so the pull does not rest on friction, and a bar across the slide lies between them
+        closing = perpendicular(approach, unit(est.direction))
     else:
         closing = perpendicular(approach, UP)
     if closing is None:
@@ -119,7 +156,9 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
     horizontal = perpendicular(approach, UP)
     if is_vertical_hinge(est, cfg):
         pitch = cfg.vertical_hinge_pitch
-    elif est.joint_type == "prismatic":
+    elif est.joint_type == "prismatic" and not slides_across_face(est, cfg, robot_side):
+        # a drawer's bar is pulled along the approach: pitched further, the tilted fingers squeeze
+        # it out along the pull (see the config); a part sliding across the approach is not
         pitch = cfg.prismatic_approach_pitch
     else:
         pitch = cfg.approach_pitch
@@ -143,3 +182,10 @@ def nearer_finger_order(frame: np.ndarray, current: np.ndarray) -> np.ndarray:
     if np.linalg.norm(rotation_error(flipped, current)) < np.linalg.norm(rotation_error(frame, current)):
         return flipped
     return frame
+
+
+def quarter_turn(frame: np.ndarray, current: np.ndarray) -> np.ndarray:
+    """TCP rotation ``frame`` (3, 3) turned a quarter turn about its approach axis (the fingers then
+    close at right angles to before), of the two ways the one nearer ``current`` (3, 3)."""
+    turn = axis_angle_matrix(frame[:, 2], 0.5 * np.pi) @ frame
+    return nearer_finger_order(turn, current)

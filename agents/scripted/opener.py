@@ -13,9 +13,12 @@ Strategy, per episode:
    orientation (while it is more than ``rotate_first_above`` rad away, for at most
    ``rotate_first_steps`` steps), and move to ``pregrasp_offset`` outside the
    grasp point along the part's outward normal ``n`` (revolute: the opening direction of the grasp point,
-   ``axis x (grasp - pivot)``; prismatic: the axis), with the TCP approach axis along ``-n`` and the
-   fingers closing perpendicular to the handle (revolute: along the radius from the axis, so a bar
-   parallel to the hinge is enclosed; prismatic: vertically). The approach is pitched below
+   ``axis x (grasp - pivot)``; prismatic: the axis, or, for a part sliding across its face, the
+   direction to the robot's base across the axis: :func:`~agents.scripted.grasp_pose.approach_normal`),
+   with the TCP approach axis along ``-n`` and the fingers closing perpendicular to the handle
+   (revolute: along the radius from the axis, so a bar parallel to the hinge is enclosed; prismatic:
+   vertically, or along the slide of a part sliding across its face). Fingers that close on nothing
+   at the handle grasp again a quarter turn on (``quarter_turn``). The approach is pitched below
    horizontal by at least ``vertical_hinge_pitch`` (doors), ``prismatic_approach_pitch`` (drawers)
    or ``approach_pitch`` (other parts), as the Panda's wrist cannot point level near the table. A
    lid (its grasp point opens upwards) is gripped from above, the fingers closing along the hinge
@@ -37,7 +40,8 @@ Strategy, per episode:
    shifted along it (prismatic); the hand turns fully with a door on a vertical hinge and by
    ``wrist_follow`` of the angle about other hinges. The estimate is re-read every step, so
    re-estimation corrects the path.
-5. ``RELEASE`` when that state reaches the target (or stops growing: a limit), open, and
+5. ``RELEASE`` when that state reaches the target (or stops growing: a limit; a part that rises as
+   it opens is held there instead, ``DONE`` with the fingers closed: let go, it falls shut), open, and
    ``RETREAT`` back along the approach axis (until there, blocked or timed out); then ``DONE``
    (hold still, gripper open).
 If the TCP stays away from the part's grasp point for ``slip_steps`` while pulling and the fingers
@@ -82,10 +86,11 @@ from agents.scripted.grasp_pose import (
     is_vertical_hinge,
     lift_pose,
     part_kind,
+    quarter_turn,
 )
 from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
 from agents.scripted.motion_axis import MotionAxis, fit_motion_axis
-from agents.scripted.panda_kinematics import PANDA_LOWER, PANDA_UPPER, pose_matrix
+from agents.scripted.panda_kinematics import PANDA_LOWER, PANDA_UPPER, base_in_world, pose_matrix
 from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, unit
 from capt_env.wrappers.joint_observation import decode_observation
 
@@ -184,10 +189,15 @@ class ScriptedOpener:
         self._settle: list[float] | None = None  # perceived states while waiting for a falling part
         self._watch: list[float] = []  # perceived states of a part that falls open, before its grasp
         self._other_fingers = False  # the next grasp turns the fingers the other way round
+        self._quarter = False  # grasps turn the fingers a quarter turn about the approach (quarter_turn)
         self.rehearsals: tuple[Rehearsal, Rehearsal] | None = None  # the last finger-order rehearsal
         self._still = 0
         self._last_p: np.ndarray | None = None
         self._last_err = (0.0, 0.0)
+        self._base: np.ndarray | None = None  # the robot's base position (m), once joint angles are seen
+        # DONE holds the part at this TCP pose (position, rotation), fingers closed: let go, it
+        # would fall back closed (see _falls_back)
+        self._hold_at: tuple[np.ndarray, np.ndarray] | None = None
 
     # --------------------------------------------------------------- helpers
     def _goto(self, p: np.ndarray, r: np.ndarray, p_des: np.ndarray, r_des: np.ndarray,
@@ -207,6 +217,16 @@ class ScriptedOpener:
         self.phase_steps = 0
         self._still = 0
         self._last_p = None
+
+    def _robot_side(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
+                    arm_qpos: np.ndarray | None) -> np.ndarray:
+        """Direction (3,) from ``est``'s grasp point to the robot's base: the base's position is
+        recovered from the arm's joint angles and the TCP pose (``p`` (3,), ``r`` (3, 3)) and kept;
+        without joint angles, the direction to the TCP (the hand comes from the robot's side)."""
+        if arm_qpos is not None and self._base is None:
+            self._base = base_in_world(np.asarray(arm_qpos, dtype=np.float64), pose_matrix(p, r))[:3, 3]
+        towards = self._base if self._base is not None else p
+        return np.asarray(towards, dtype=np.float64) - np.asarray(est.grasp_point, dtype=np.float64)
 
     def _grasp_point_moved(self, est: JointAxisEstimate) -> bool:
         """Whether ``est``'s grasp point is more than ``rechoose_grasp_m`` m from the one the grasp
@@ -304,7 +324,9 @@ class ScriptedOpener:
                 if self._target_r is None:  # a new grasp (not a new choice for this one)
                     self._swap_this_grasp, self._other_fingers = self._other_fingers, False
                     self._pregrasp_steps = 1
-                self._target_r = grasp_rotation(est, r, cfg)
+                self._target_r = grasp_rotation(est, r, cfg, self._robot_side(est, p, r, arm_qpos))
+                if self._quarter:
+                    self._target_r = quarter_turn(self._target_r, r)
                 if cfg.rehearse_fingers and arm_qpos is not None and not is_lid(est, cfg):
                     self._target_r = self._rehearsed_fingers(est, p, r, arm_qpos, self._target_r)
                 if self._swap_this_grasp:
@@ -352,15 +374,26 @@ class ScriptedOpener:
                     self._set(Phase.RELEASE, "empty")
                 elif (not self._lid and cfg.regrasp_other_fingers and finger_gap is not None
                         and finger_gap < cfg.hold_gap and self.regrasps < cfg.max_regrasps):
-                    # the fingers closed on nothing: the arm stopped short of the handle (a low handle
-                    # can put a wrist joint at its limit in one of the two finger orders); back off
-                    # and grasp again with the fingers the other way round
+                    # the fingers closed on nothing: back off and grasp again. If the
+                    # approach timed out or a wrist joint is at its limit, the arm stopped short of the
+                    # handle (a low handle can put one there in one of the two finger orders): the
+                    # fingers the other way round. Otherwise the hand is at the handle (there, or
+                    # stopped by touching it), which does not lie across the fingers (a lever or bar
+                    # at right angles to the one expected): the fingers a quarter turn on
                     self.regrasps += 1
-                    self._grasp_again = self._other_fingers = True
+                    self._grasp_again = True
+                    short = self._reach_why == "timeout" or wrist_at_limit(arm_qpos, cfg.wrist_limit_margin)
+                    if not cfg.quarter_turn or short:
+                        self._other_fingers = True
+                    else:
+                        self._quarter = not self._quarter
                     self._set(Phase.RELEASE, "empty")
+                    self.phase_log[-1]["gap"] = round(finger_gap, 4)
                 else:
                     empty = finger_gap is not None and finger_gap < cfg.hold_gap
                     self._start_pull(p, r, est, "empty" if empty else "closed")
+                    if finger_gap is not None:
+                        self.phase_log[-1]["gap"] = round(finger_gap, 4)
             return action
 
         if self.phase == Phase.PULL:
@@ -392,7 +425,16 @@ class ScriptedOpener:
                     self._set(Phase.DONE, "retreated")
             return action
 
+        if self._hold_at is not None:  # keep the hand, and the part it holds, where the pull ended
+            return self._goto(p, r, *self._hold_at, GRIPPER_CLOSE)[0]
         return hold(GRIPPER_OPEN)
+
+    def _falls_back(self, u: np.ndarray, revolute: bool) -> bool:
+        """Whether a prismatic part opening along unit ``u`` (3,) rises more than
+        ``hold_rising_above`` rad above horizontal, so that gravity slides it back closed once let go
+        (a window sliding up; 0: never)."""
+        rise = self.cfg.hold_rising_above
+        return not revolute and rise > 0.0 and float(u[2]) > float(np.sin(rise))
 
     def _rehearse(self, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray, arm_qpos: np.ndarray,
                   rotation: np.ndarray) -> Rehearsal:
@@ -659,6 +701,11 @@ class ScriptedOpener:
                 self._grasp_again = False
             self.regrasps += int(self._grasp_again)
             self._let_go_state = state
+            if not self._grasp_again and holding and self._falls_back(u, revolute):
+                # let go, a part lifted against gravity slides back closed: hold it where it is
+                self._hold_at = (p.copy(), r.copy())
+                self._set(Phase.DONE, "target" if state >= target else "stall" if stalled else "limit")
+                return hold(GRIPPER_CLOSE)
             if self._grasp_again and wrist_stuck:
                 # the arm ran out of range with this finger order: the other one turns the wrist
                 # the other way

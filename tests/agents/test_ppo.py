@@ -32,12 +32,13 @@ def tiny(**changes: object) -> PPOTrainConfig:
 # the opener options each shipped residual policy was trained (and measured) with, pinned in its
 # run config so that later changes to the opener's defaults do not change the policy
 SHIPPED_OPENERS = {
-    "laptop": {"arc_fit": True, "regrasp_other_fingers": True, "approach_gap": 0.06,
+    "laptop": {"arc_fit": True, "regrasp_other_fingers": True, "quarter_turn": False, "approach_gap": 0.06,
                "wrist_limit_margin": 0.05, "lid_lift_inward": 0.02, "lid_lift_lead": 0.2,
                "fall_open_done": 1.3, "revolute_stop_above": 0.0, "rehearse_fingers": False,
                "rechoose_grasp_m": 0.0, "watch_falling": False, "prismatic_approach_pitch": 0.55,
                "prismatic_stop_above": 0.0, "rechoose_part_kind": False},
-    "drawer_cabinet": {"arc_fit": True, "regrasp_other_fingers": True, "approach_gap": 0.06,
+    "drawer_cabinet": {"arc_fit": True, "regrasp_other_fingers": True, "quarter_turn": False,
+                       "approach_gap": 0.06,
                        "wrist_limit_margin": 0.05, "lid_lift_lead": 0.12, "fall_open_done": 0.0,
                        "revolute_stop_above": 0.0, "rehearse_fingers": False,
                        "rechoose_grasp_m": 0.0, "watch_falling": False,

@@ -17,6 +17,7 @@ from agents.scripted.grasp_pose import (
     lift_pose,
     outward_normal,
     part_kind,
+    slides_across_face,
 )
 from agents.scripted.opener import ACTION_SCALE_M, Phase
 from agents.scripted.panda_kinematics import tcp_pose
@@ -164,6 +165,11 @@ def _pose(rotation: np.ndarray, position: np.ndarray) -> np.ndarray:
     return np.concatenate([position, quat])
 
 
+# a wrist joint (5) at its upper limit, and one with every wrist joint well inside its range
+WRIST_AT_LIMIT = np.array([0.0, 0.0, 0.0, -1.5, 2.89, 1.5, 0.0])
+WRIST_FREE = np.array([0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0])
+
+
 def test_fingers_that_closed_on_nothing_grasp_again_the_other_way_round() -> None:
     cfg = ScriptedOpenerConfig()
     est = _closed_drawer()
@@ -174,8 +180,8 @@ def test_fingers_that_closed_on_nothing_grasp_again_the_other_way_round() -> Non
     assert opener._target_r is not None
     np.testing.assert_allclose(opener._target_r, start, atol=1e-9)  # the nearer order: the one it has
     opener._set(Phase.CLOSE, "reached")
-    for _ in range(cfg.close_steps):
-        opener.act_on(est, at_handle, finger_gap=0.0)
+    for _ in range(cfg.close_steps):  # the arm stopped with a wrist joint at its limit
+        opener.act_on(est, at_handle, finger_gap=0.0, arm_qpos=WRIST_AT_LIMIT)
     assert opener.phase == Phase.RELEASE and opener.regrasps == 1
     for _ in range(cfg.release_steps):
         opener.act_on(est, at_handle)
@@ -195,6 +201,107 @@ def test_fingers_that_closed_on_nothing_grasp_again_the_other_way_round() -> Non
         for _ in range(cfg.close_steps):
             opener.act_on(est, at_handle, finger_gap=gap)
         assert opener.phase == phase and opener.regrasps == 0
+
+
+def _regrasp_after_a_miss(est: JointAxisEstimate, finger_gap: float, arm_qpos: np.ndarray,
+                          approach_end: str = "reached") -> tuple[np.ndarray, np.ndarray]:
+    """The first and the next grasp rotation (3, 3) of an opener whose approach ended
+    ``approach_end`` ("reached", "blocked", "timeout") and whose fingers then closed to ``finger_gap``
+    m at ``est``'s grasp point, the arm at ``arm_qpos``."""
+    cfg = ScriptedOpenerConfig()
+    opener = ScriptedOpener(cfg)
+    start = grasp_rotation(est, np.eye(3), cfg)
+    at_handle = _pose(start, est.grasp_point)
+    opener.act_on(est, at_handle)
+    opener._reach_why = approach_end
+    opener._set(Phase.CLOSE, approach_end)
+    for _ in range(cfg.close_steps):
+        opener.act_on(est, at_handle, finger_gap=finger_gap, arm_qpos=arm_qpos)
+    assert opener.phase == Phase.RELEASE and opener.regrasps == 1
+    for _ in range(cfg.release_steps):
+        opener.act_on(est, at_handle)
+    backed_off = _pose(start, est.grasp_point - start[:, 2] * cfg.retreat_distance)
+    opener.act_on(est, backed_off)
+    assert opener.phase == Phase.PREGRASP
+    opener.act_on(est, backed_off)
+    return start, opener._target_r
+
+
+def _safe_door() -> JointAxisEstimate:
+    # a door hinged along -z at (0.26, 0.17), a lever handle on it 0.37 m out, in front (-x) of the hinge
+    return JointAxisEstimate("revolute", np.array([0.0, 0.0, -1.0]), np.array([0.26, 0.17, 0.15]), 0.0,
+                             np.array([0.06, -0.14, 0.15]))
+
+
+def test_a_lever_across_the_fingers_is_grasped_again_with_the_fingers_a_quarter_turn_on() -> None:
+    # the hand got to the lever (there, or stopped by touching it) with its wrist free, and its
+    # fingers, closing along the radius from the hinge, i.e. along the lever, closed on nothing
+    for end in ("reached", "blocked"):
+        start, again = _regrasp_after_a_miss(_safe_door(), 0.0, WRIST_FREE, end)
+        np.testing.assert_allclose(again[:, 2], start[:, 2], atol=1e-9)  # the same approach
+        assert abs(float(again[:, 1] @ start[:, 1])) < 1e-9  # the fingers close at right angles
+    # with a wrist joint at its limit, or an approach that timed out, the arm stopped short of the
+    # handle: the fingers the other way round
+    for arm, end in ((WRIST_AT_LIMIT, "reached"), (WRIST_FREE, "timeout")):
+        start, again = _regrasp_after_a_miss(_safe_door(), 0.0, arm, end)
+        np.testing.assert_allclose(again[:, 1], -start[:, 1], atol=1e-9)
+
+
+def _sliding(direction: list[float]) -> JointAxisEstimate:
+    # a panel 0.9 m in front of the robot's base (-0.615, 0, 0), its handle at (0.3, 0, 0.2),
+    # sliding along ``direction``
+    return JointAxisEstimate("prismatic", np.array(direction), np.array([0.4, 0.0, 0.2]), 0.0,
+                             np.array([0.3, 0.0, 0.2]))
+
+
+ROBOT_SIDE = np.array([-0.615, 0.0, 0.0]) - np.array([0.3, 0.0, 0.2])
+
+
+def test_a_sliding_panel_that_moves_sideways_is_gripped_square_on_and_pulled_sideways() -> None:
+    cfg = ScriptedOpenerConfig()
+    est = _sliding([0.0, 1.0, 0.0])
+    assert slides_across_face(est, cfg, ROBOT_SIDE)
+    rot = grasp_rotation(est, np.eye(3), cfg, ROBOT_SIDE)
+    pitch = cfg.approach_pitch
+    # towards the face (+x) from the robot's side, pitched down; the fingers close along the slide
+    np.testing.assert_allclose(rot[:, 2], [np.cos(pitch), 0.0, -np.sin(pitch)], atol=1e-9)
+    assert abs(float(rot[:, 1] @ est.direction)) == pytest.approx(1.0)
+    # the pull leads the handle along the slide, not towards the robot
+    opener = ScriptedOpener(ScriptedOpenerConfig(max_step_m=1.0))
+    opener._start_pull(est.grasp_point, rot, est, "closed")
+    move = opener._pull(est, est.grasp_point, rot, finger_gap=0.02)[:3] * ACTION_SCALE_M
+    np.testing.assert_allclose(move, [0.0, cfg.prismatic_lead, 0.0], atol=1e-9)
+
+
+def test_a_window_sliding_up_is_gripped_from_the_front_with_the_fingers_along_the_slide() -> None:
+    cfg = ScriptedOpenerConfig()
+    est = _sliding([0.0, 0.0, 1.0])
+    rot = grasp_rotation(est, np.eye(3), cfg, ROBOT_SIDE)
+    pitch = cfg.approach_pitch
+    np.testing.assert_allclose(rot[:, 2], [np.cos(pitch), 0.0, -np.sin(pitch)], atol=1e-9)
+    np.testing.assert_allclose(abs(rot[:, 1]), [np.sin(pitch), 0.0, np.cos(pitch)], atol=1e-9)
+    # without the robot's side, or for a drawer sliding out towards the robot, along the axis as before
+    assert not slides_across_face(est, cfg, None)
+    drawer = _sliding([-1.0, 0.0, 0.0])
+    assert not slides_across_face(drawer, cfg, ROBOT_SIDE)
+    np.testing.assert_allclose(grasp_rotation(drawer, np.eye(3), cfg, ROBOT_SIDE),
+                               grasp_rotation(drawer, np.eye(3), cfg), atol=1e-12)
+
+
+def test_a_window_lifted_open_is_held_there_not_let_go_to_fall_shut() -> None:
+    cfg = ScriptedOpenerConfig()
+    for direction, kept in (([0.0, 0.0, 1.0], True), ([-1.0, 0.0, 0.0], False)):
+        est = _sliding(direction)
+        opener = ScriptedOpener(cfg)
+        opener._start_pull(est.grasp_point, np.eye(3), est, "closed")
+        top = est.grasp_point + np.array(direction) * (cfg.prismatic_target + 0.01)
+        opener.act_on(est, _pose(np.eye(3), top), finger_gap=0.02)
+        if not kept:  # a drawer pulled out is let go
+            assert opener.phase == Phase.RELEASE
+            continue
+        assert opener.phase == Phase.DONE and opener.phase_log[-1]["why"] == "target"
+        sagged = opener.act_on(est, _pose(np.eye(3), top - [0.0, 0.0, 0.01]), finger_gap=0.02)
+        assert sagged[6] == -1.0 and sagged[2] > 0.0  # fingers closed, the hand back up to where it held
 
 
 def _oven() -> JointAxisEstimate:
@@ -672,21 +779,23 @@ def test_the_finger_order_the_wrist_cannot_reach_is_rehearsed_and_not_taken() ->
     # the hand points down with joint 7 turned 1.8 rad from where the TCP's x is world +x: of the two
     # finger orders for a straight-down grasp (x = +x or -x), the nearer one (1.34 rad) needs joint 7
     # at 3.94 rad, past its 2.90 limit; the farther one (1.8 rad the other way) brings it back to 0.8
+    # (the part comes straight up out of its top towards the hand: approached along its axis)
+    along = {"slide_across_min_angle": 3.0}
     q = np.array([0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 2.6])
     tcp = tcp_pose(q)  # the base at the world origin
     lift = JointAxisEstimate("prismatic", np.array([0.0, 0.0, 1.0]), tcp[:3, 3] - [0, 0, 0.15], 0.0,
                              tcp[:3, 3] - [0, 0, 0.15])
     pose = np.concatenate([tcp[:3, 3], Rotation.from_matrix(tcp[:3, :3]).as_quat(scalar_first=True)])
-    plain = ScriptedOpener(ScriptedOpenerConfig(rehearse_fingers=False, prismatic_target=0.1))
+    plain = ScriptedOpener(ScriptedOpenerConfig(rehearse_fingers=False, prismatic_target=0.1, **along))
     plain.act_on(lift, pose, finger_gap=0.06, arm_qpos=q)
     assert plain._target_r[:, 0] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(-1.0, abs=1e-6)
-    rehearsed = ScriptedOpener(ScriptedOpenerConfig(prismatic_target=0.1))
+    rehearsed = ScriptedOpener(ScriptedOpenerConfig(prismatic_target=0.1, **along))
     rehearsed.act_on(lift, pose, finger_gap=0.06, arm_qpos=q)
     nearer, other = rehearsed.rehearsals
     assert nearer.grasp_error_rad > 2 * 0.12 and other.pull_share == 1.0
     assert rehearsed._target_r[:, 0] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(1.0, abs=1e-6)
     # without the arm's joint angles there is nothing to rehearse: the nearer order
-    blind = ScriptedOpener(ScriptedOpenerConfig(prismatic_target=0.1))
+    blind = ScriptedOpener(ScriptedOpenerConfig(prismatic_target=0.1, **along))
     blind.act_on(lift, pose)
     assert blind.rehearsals is None and np.allclose(blind._target_r, plain._target_r)
 

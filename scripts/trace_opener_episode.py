@@ -1,0 +1,86 @@
+"""Trace one scripted-opener episode step by step: phase, TCP, finger gap, the estimate and the part's
+true state, for finding which situation an opening fails in (development seeds only).
+
+    python scripts/trace_opener_episode.py --objects data/real_objects/corpus.yaml --name mw_window \
+        --seed 100 --every 5 --json /tmp/trace.json
+
+Prints one line every ``--every`` steps and at each phase change; ``--json`` keeps every step.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+
+from agents.scripted import ScriptedOpener
+from agents.scripted.geometry import quat_to_matrix
+from capt_env.commands.object_targets import load_objects_yaml, target_task
+from capt_env.commands.task_overrides import task_overrides
+from capt_env.env_factory import make_env
+from capt_env.wrappers.joint_observation import decode_observation
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--objects", default="data/real_objects/corpus.yaml")
+    parser.add_argument("--name", required=True, help="the object's label in --objects, or a category")
+    parser.add_argument("--seed", type=int, default=100)
+    parser.add_argument("--task", default="two_cameras")
+    parser.add_argument("--max-steps", type=int, default=200)
+    parser.add_argument("--every", type=int, default=5)
+    parser.add_argument("--json", default=None)
+    args = parser.parse_args()
+    if args.seed >= 10000:
+        raise SystemExit("seeds from 10000 are held out for reporting; trace development seeds")
+    task = task_overrides(args.task)
+    targets = {t.label: t for t in load_objects_yaml(args.objects)}
+    if args.name in targets:
+        env = make_env(None, {"source": "oracle"}, task=target_task(targets[args.name], task))
+    else:
+        env = make_env(args.name, {"source": "oracle"}, task=task)
+    opener = ScriptedOpener()
+    obs, info = env.reset(seed=args.seed)
+    opener.reset()
+    steps, last_phase = [], None
+    for step in range(1, args.max_steps + 1):
+        proprio, est = decode_observation(obs)
+        qpos = np.asarray(proprio["qpos"], dtype=np.float64).reshape(-1)
+        tcp = np.asarray(proprio["tcp_pose"], dtype=np.float64)
+        action = opener.act(obs, info)
+        if step == 1:
+            approach = opener._target_r[:, 2] if opener._target_r is not None else None
+            print(f"joint {est.joint_type} axis {np.round(est.direction, 3)} pivot {np.round(est.pivot, 3)} "
+                  f"grasp {np.round(est.grasp_point, 3)} approach {np.round(approach, 3)} "
+                  f"closing {np.round(opener._target_r[:, 1], 3)} base {opener._base} "
+                  f"tcp {np.round(tcp[:3], 3)}")
+            print("rehearsals (nearer, other):", opener.rehearsals)
+        obs, _, _, truncated, info = env.step(action)
+        row = {"step": step, "phase": opener.phase.value, "tcp": tcp[:3].round(4).tolist(),
+               "gap": round(float(qpos[7] + qpos[8]), 4), "state": round(float(est.state), 4),
+               "grasp": np.round(est.grasp_point, 4).tolist(),
+               "open_fraction": round(float(info["open_fraction"]), 3),
+               "action": np.round(action, 2).tolist(),
+               "approach": np.round(quat_to_matrix(tcp[3:7])[:, 2], 3).tolist(),
+               "closing": np.round(quat_to_matrix(tcp[3:7])[:, 1], 3).tolist(),
+               "arm": np.round(qpos[:7], 2).tolist()}
+        steps.append(row)
+        if opener.phase.value != last_phase or step % args.every == 0:
+            print(f"{step:4d} {row['phase']:9s} tcp {row['tcp']} gap {row['gap']:.4f} "
+                  f"state {row['state']:+.3f} open {row['open_fraction']:.2f} grasp {row['grasp']} "
+                  f"act {row['action']} appr {row['approach']} clos {row['closing']} arm {row['arm']}")
+            if opener.phase.value == "approach" and last_phase != "approach":
+                print("     rehearsals (nearer, other):", opener.rehearsals)
+            last_phase = opener.phase.value
+        if truncated:
+            break
+    print("success", bool(info["success"]), "log", opener.phase_log)
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump({"steps": steps, "phase_log": opener.phase_log}, fh)
+    env.close()
+
+
+if __name__ == "__main__":
+    main()
