@@ -2,7 +2,9 @@
 
 Pure Python (stdlib + PyYAML), shared by every package of capt-env. Defaults live in the dataclasses;
 a YAML file mirrors a dataclass one to one and only overrides what it names. Each dataclass may define
-``validate(self) -> None`` that raises ``ConfigError`` for a bad value; it runs after loading.
+``validate(self) -> None`` that raises ``ConfigError`` for a bad value; it runs after loading. A
+dataclass whose keys were renamed may define a classmethod ``upgrade_legacy_keys(data, where) -> dict``
+that maps a mapping's old keys onto the new ones (warning about them) before the strict check.
 """
 
 from __future__ import annotations
@@ -93,6 +95,9 @@ def from_dict(cls: type[T], data: Any, where: str = "config") -> T:
         return data
     if not isinstance(data, dict):
         raise ConfigError(f"{where}: expected a mapping for {cls.__name__}, got {data!r}")
+    upgrade = getattr(cls, "upgrade_legacy_keys", None)
+    if callable(upgrade):
+        data = upgrade(data, where)
     hints = typing.get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     unknown = sorted(set(data) - set(fields))

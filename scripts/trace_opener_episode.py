@@ -50,10 +50,10 @@ def main() -> None:
         tcp = np.asarray(proprio["tcp_pose"], dtype=np.float64)
         action = opener.act(obs, info)
         if step == 1:
-            approach = opener._target_r[:, 2] if opener._target_r is not None else None
+            approach = opener.ctx.grasp.target_r[:, 2] if opener.ctx.grasp.target_r is not None else None
             print(f"joint {est.joint_type} axis {np.round(est.direction, 3)} pivot {np.round(est.pivot, 3)} "
                   f"grasp {np.round(est.grasp_point, 3)} approach {np.round(approach, 3)} "
-                  f"closing {np.round(opener._target_r[:, 1], 3)} base {opener._base} "
+                  f"closing {np.round(opener.ctx.grasp.target_r[:, 1], 3)} base {opener.ctx.base} "
                   f"tcp {np.round(tcp[:3], 3)}")
             print("rehearsals (nearer, other):", opener.rehearsals)
         obs, _, _, truncated, info = env.step(action)

@@ -1,300 +1,631 @@
-"""Typed config of the scripted opener (metres, radians, control steps at 20 Hz)."""
+"""Typed config of the scripted opener: one nested dataclass per part of the method (world frame;
+metres, radians, control steps at 20 Hz).
+
+``ScriptedOpenerConfig`` groups the options by what they govern: ``move`` (every straight move of the
+hand), ``approach`` (the pre-grasp and the approach), ``grasp`` (closing the fingers and choosing the
+finger order), ``pull``, ``release``, ``recovery`` (grasping again), and one group per part kind whose
+rules differ (``side_door``, ``lid``, ``falling_door``, ``drawer``, ``sliding_panel``). Each option's
+docstring says why it has its value. YAML files mirror the tree (``approach: {pitch: 0.55}``); the
+flat keys of earlier releases (``approach_pitch: 0.55``) still load, mapped by :data:`LEGACY_KEYS`
+with a warning (see :func:`upgrade_legacy_keys`). The traced episodes behind the defaults are in
+``docs/scripted_opener.md``.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, field, fields, is_dataclass
+from typing import Any
 
 import numpy as np
 
 from capt_common.typed_yaml import require
 
 
+def _positive(obj: Any, *keys: str, where: str = "") -> None:
+    for key in keys:
+        value = getattr(obj, key)
+        require(value > 0, f"{where}{key} must be > 0, got {value}")
+
+
+def _at_least_one(obj: Any, *keys: str, where: str = "") -> None:
+    for key in keys:
+        value = getattr(obj, key)
+        require(value >= 1, f"{where}{key} must be >= 1, got {value}")
+
+
+def _non_negative(obj: Any, *keys: str, where: str = "", note: str = "") -> None:
+    for key in keys:
+        value = getattr(obj, key)
+        require(value >= 0, f"{where}{key} must be >= 0{note}, got {value}")
+
+
+def _share(obj: Any, *keys: str, where: str = "") -> None:
+    for key in keys:
+        value = getattr(obj, key)
+        require(0.0 <= value <= 1.0, f"{where}{key} must be in [0, 1], got {value}")
+
+
+def _angle(value: float, name: str, high: float = 1.5) -> None:
+    require(0.0 <= value <= high, f"{name} must be in [0, {high}] rad, got {value}")
+
+
 @dataclass(frozen=True)
-class ScriptedOpenerConfig:
-    """Gains, offsets and targets of :class:`agents.scripted.opener.ScriptedOpener`.
+class MoveConfig:
+    """Every straight move of the hand (pre-grasp, approach, retreat) and every pull step, in
+    ``pd_ee_delta_pose`` control steps."""
 
-    Approach: pre-grasp ``pregrasp_offset`` m outside the grasp point along the part's outward normal,
-    then ``grasp_depth`` m past it. The approach direction points at least ``vertical_hinge_pitch`` rad
-    below horizontal for parts hinged about a near-vertical axis (the axis within
-    ``vertical_hinge_max_tilt`` rad of vertical: doors; the hand only yaws while pulling) and
-    ``approach_pitch`` rad for other hinges (oven doors, lids: the hand pitches while pulling, so
-    it starts nearer level) and ``prismatic_approach_pitch`` for drawers; a level Panda hand near the
-    table is beyond its wrist limits. A drawer's handle 8 cm above the table, approached 0.55 rad
-    down, ran wrist joint 5 into its limit short of the grasp orientation, and the tilted fingers
-    squeezed the bar out (drawer seeds 38, 41, 94, 133, 157, 162; 0.3 rad opened them). A prismatic
-    part whose axis lies more than ``slide_across_min_angle`` rad from the horizontal direction to the
-    robot's base slides across its face (a window sliding up, a sliding door): the hand approaches
-    that face square on from the robot's side, ``approach_pitch`` rad down, the fingers closing along
-    the slide, and pulls along the axis whatever way it points
-    (:func:`~agents.scripted.grasp_pose.slides_across_face`); a part whose axis points nearer the
-    robot comes out of its face like a drawer. A prismatic part whose opening direction rises more
-    than ``hold_rising_above`` rad above horizontal (a window sliding up) is held where the pull
-    ended, not let go: gravity slides it back closed (0: off). The hand first
-    turns in place to the grasp orientation while it is more than ``rotate_first_above`` rad from it, for
-    at most ``rotate_first_steps`` steps (turned while travelling, the arm's IK reaches a low, far handle
-    with the wrist at its joint limit and cannot hold the pose while pulling; 0 steps: never). The grasp
-    orientation is chosen as the pre-grasp move starts and chosen again, the move starting over, when
-    in the first ``rechoose_steps`` steps of the grasp's pre-grasp the perceived grasp point is more
-    than ``rechoose_grasp_m`` m from the one it was chosen for (0: never): a first look that finds no
-    handle puts the grasp point on the part's far edge, and an orientation chosen for that point does
-    not suit the handle seen a few steps later (not later on: an open part's grasp point jumps about
-    from look to look, and each start over turns the hand first). With ``rechoose_looks`` n > 1,
-    only when each of the last n looks (new estimates) is that far from it and they agree with each
-    other within ``rechoose_grasp_m`` (CAPT's grasp point on a washing machine's door can jump between
-    looks: on seeds 2 and 4 the orientation was chosen again on three looks running and the fingers
-    then closed on nothing; 2, the default since session 20, opened 5 more of 200 washing machines with
-    CAPT than 1, 2 more ovens, as many laptops and one cabinet door fewer). With
-    ``rechoose_part_kind`` the orientation is also chosen again, in those steps and on those looks,
-    when the part's kind (:func:`~agents.scripted.grasp_pose.part_kind`: lid, side door, other hinge)
-    differs from the one it was chosen for: a first look that tilts a door's hinge into a lid's sent
-    the hand to the door's top edge (cabinet door seed 3 with CAPT). The fingers
-    approach ``approach_gap`` m apart (the Panda opens to 0.08 m; a narrower gap keeps a pitched fingertip
-    off the surface a handle stands on, but under 6 cm a finger pitched across a drawer's bar clips its
-    edge when the grasp point is half a centimetre off). Moves are capped at ``max_step_m`` /
-    ``max_step_rad`` per control step; ``pos_tolerance`` / ``rot_tolerance`` end a move, as do
-    ``move_timeout`` steps or ``blocked_steps`` steps without TCP motion (contact). A lid (a revolute part
-    whose grasp point opens within ``lid_max_tilt`` rad of straight up, like a closed laptop) is gripped
-    from above with the fingers ``lid_approach_gap`` m apart and closing along the hinge, across its front
-    lip, ``lid_edge_offset`` m beyond the grasp point away from the hinge (so the pads clear the lid's
-    edge whether the grasp point is the lip's centre, as with ground truth, or the outer band of its
-    points, as from CAPT); the hand turns by ``lid_wrist_follow`` of the lid's angle (the pinch lets the
-    lip turn between the pads; a hand turned with the lid would point back at the robot), and pulls to
-    ``lid_revolute_target`` rad (past upright, so the lid does not rest on its hinge's friction just short
-    of the success angle). If the fingers close on nothing across a lid's lip (it is wider than the open
-    fingers), the hand backs off and lifts the lid from below (``lid_lift``): fingers closed, pointing at
-    the hinge ``lid_lift_pitch`` rad below horizontal, the fingertips go ``lid_lift_below`` m under the
-    grasp point, from ``lid_lift_front`` m in front of it to ``lid_lift_under`` m behind it, and push the
-    lid open along the same arc as a pull, ``lid_lift_lead`` rad ahead of it (pushing from below, the
-    fingertips carry the lid's weight; the larger lead pushes harder, through the stall near 0.4 rad
-    that a lead of ``revolute_lead`` met with an estimated hinge), the hand turning by
-    ``lid_lift_wrist_follow`` of the lid's angle and moving ``lid_lift_inward`` m towards the hinge per
-    radian the lid has turned (on an estimated hinge 1-2 cm off, the fingertips following its arc slid off
-    the lip at about 1.2 rad; sliding towards the hinge they stay under the lid). ``close_steps`` steps
-    close the gripper. Pulling leads the part by ``revolute_lead`` rad or ``prismatic_lead`` m. The hand
-    turns with a door about a vertical hinge, and by ``wrist_follow`` of the part's angle about any other
-    hinge (a grasped bar turns between the pads; a hand turned fully with an oven door reaches the Panda's
-    wrist limit). Pulling stops at ``revolute_target`` rad / ``prismatic_target`` m, or when the state
-    grew by less than ``stall_progress`` rad / ``stall_progress_m`` m over ``stall_steps`` steps (a limit,
-    or a lost grip).
-    The gripper re-grasps (at most ``max_regrasps`` times) if it stays more than ``slip_distance`` m from
-    the part's perceived grasp point for ``slip_steps`` steps (longer than the perception period, so one
-    bad estimate, e.g. of a handle the hand now hides, is not a slip) and its fingers are less than
-    ``hold_gap`` m apart (closed on nothing; a gap means they hold the handle, whatever the perceived
-    grasp point says). With ``lid_slip_off_axis``, a lid's slip distance leaves out its component
-    along the estimated hinge: a lid has no handle, and its grasp point (the mean of the far edge's
-    visible points) slides along the edge as the hand hides part of it (laptop seeds 6 and 38 with a
-    fine-tuned model: 11-13 cm along the hinge mid-pull read as a slip, and the re-grasps ran out
-    the episode at 58% and 5% open). Pulling a prismatic part ends for good, without a re-grasp,
-    when the hand, having pulled at a cruising speed of at least ``limit_min_speed_m`` m per step,
-    moves less than
-    ``limit_slowdown`` of that speed for ``limit_window`` steps: the part has hit its end stop (pulled on,
-    the handle would slide out of the fingers and a re-grasp would chase an open drawer; gripped at
-    ``prismatic_approach_pitch`` 0.3 rad the handle slides out sooner, the hand slowing only to 0.6-0.8
-    of its speed: with 0.6, 63 of 200 drawer episodes ran 30 or more steps longer, the stop missed and
-    the open drawer grasped twice more, seeds 4, 5, 8). When that brake is missed all the same (the
-    handle slid out of the fingers at the end stop before the hand's slowing was read), a slip from a
-    prismatic part whose state, by the hand's own measure, is past ``prismatic_stop_above`` m (0: off)
-    also ends the pull for good: the re-grasp's approach pushed the open drawer back in (CAPT seeds
-    34, 54, 119: pulled 100% open, slipped, then 21-42% open at the end). After release it
-    backs off ``retreat_distance`` m. With ``regrasp_other_fingers``, fingers that close on nothing (gap
-    below ``hold_gap``; not a lid's) open, back off and grasp again with the fingers the other way round
-    (a re-grasp): for a low handle one of the two finger orders can leave a wrist joint at its limit short
-    of the handle. With ``quarter_turn``, that is so only when the approach timed out (``move_timeout``)
-    or a wrist joint is within ``wrist_limit_margin`` of its limit as the fingers close; otherwise the
-    hand reached the handle (its goal, or blocked by touching it) and the handle does not lie across
-    the fingers (a lever bar at right angles to a door's hinge, where the fingers close along the
-    radius for a bar parallel to it), so this and later grasps turn the fingers a quarter turn about
-    the approach (each such miss turns them back). A pull that stalls with one of the Panda's wrist
-    joints (5, 6, 7) within ``wrist_limit_margin`` rad of its limit (0: off) grasps again that way
-    too: the arm ran out of range
-    with this finger order (oven doors), and grasping again the same way returns it to the same limit.
-    A door that gravity opens further once let go (hinged below its grasp point about a non-vertical
-    axis and not a lid: an oven door) is not grasped again once the pull ends (stall or slip) past
-    ``fall_open_done`` rad by both the hand's measure and the perceived state (reaching for the handle
-    of a door near level pushes it back). Let go past
-    ``settle_above`` rad (a door let go nearer closed falls too slowly to wait for), the open hand
-    backs off, moves ``settle_clearance`` m beyond the grasp radius about the estimated hinge (out of
-    the door's sweep) and waits while the perceived state still rises by ``settle_progress`` rad over
-    ``settle_window`` steps (a door falling open; one that creeps is grasped again; at most
-    ``settle_max_steps``); then it is done if the door fell past ``fall_open_done`` and grasps again
-    otherwise (``fall_open_done`` 0: all of this off). With ``watch_falling``, such a door seen falling
-    open before it is grasped (at least ``settle_above`` rad open and risen by ``settle_progress`` rad
-    over the last ``settle_window`` steps: the hand turning in front of it brushed it, or it was let go
-    short of open) is not reached for (reaching for the handle pushed it back, oven seeds 57 and 129):
-    the hand clears its sweep and waits the same way, then grasps it anew if it stopped short.
-    A pull of any other revolute part (not a lid, nor a door that falls open) that stalls past
-    ``revolute_stop_above`` rad (the hand's own measure), the fingers still holding and no wrist joint
-    at its limit, has met the part's end stop and is not grasped again (0: off): a side-hinged door
-    whose limit (1.5-2.0 rad) lies short of ``revolute_target`` stalls there, and grasping it again
-    knocked it back towards closed.
-    With ``arc_fit``, a hinge is also measured by the hand that holds its part: once the TCP, with the
-    fingers apart (holding), has moved ``arc_fit_min_chord`` m and ``arc_fit_min_angle`` rad (about the
-    estimated hinge) from where the pull began, a circle is fitted to its path about the estimated axis
-    direction; if the path lies within ``arc_fit_max_rms`` m of that circle and its centre is within
-    ``arc_fit_max_shift`` m of the estimated line, the centre replaces the estimated pivot for the rest of
-    this pull (the swept angle and the arc the hand follows; the first accepted fit is kept, as a hand
-    slipping off the handle later leaves the arc). A pivot a few cm off the hinge of a 20 cm door reads
-    the swept angle 0.4 rad too large, and the hand lets go short of open.
-    With ``motion_axis`` (off by default), the axis is also measured by how the part moved: the
-    estimated grasp points seen while the fingers held the part (every pull of the episode) are fitted
-    with a line (prismatic) or a circle in a plane (revolute: the plane's normal is the axis, the
-    circle's centre its pivot; :func:`agents.scripted.motion_axis.fit_motion_axis`) once they spread
-    ``motion_axis_min_travel`` m and, revolute, sweep ``motion_axis_min_angle`` rad and number
-    ``motion_axis_hinge_points`` (a line needs 3; a plane and circle through 4 fit anything); a fit within
-    ``motion_axis_max_rms`` m of the points, whose points spread off the line or plane at most
-    ``motion_axis_max_ratio`` of their spread along it, and within ``motion_axis_max_turn`` rad of
-    the estimated direction replaces the estimated axis for the rest of the episode (the pull starts
-    over from where the hand is). An axis a few degrees off makes the commanded arc or line leave
-    the part's own, and the fingers slide off it (``capt noise-sweep``).
-    With ``rehearse_fingers`` (and the arm's joint angles in the observation), the two finger orders of
-    a grasp (not a lid's) are first rehearsed on the Panda's kinematic model
-    (:mod:`agents.scripted.grasp_rehearsal`): turn, pre-grasp, approach and the pull to its target,
-    each step capped as above and every joint stopped at its limit. The other order than the one
-    nearer the hand's rotation is taken only if it reaches the grasp pose (within twice the
-    tolerances) and follows the whole pull path (tracked within ``rehearse_track_m`` m), and the
-    nearer one does not reach the grasp pose or falls behind before ``1 - rehearse_margin`` of the
-    path (when both fall behind part-way, which does better on the robot was a coin toss: oven
-    seeds 35 and 140).
-    """
-
-    pregrasp_offset: float = 0.08
-    grasp_depth: float = 0.01
-    approach_pitch: float = 0.55
-    prismatic_approach_pitch: float = 0.3
-    slide_across_min_angle: float = 0.785
-    hold_rising_above: float = 0.3
-    vertical_hinge_pitch: float = 0.8
-    vertical_hinge_max_tilt: float = 0.8
-    rotate_first_above: float = 0.4
-    rotate_first_steps: int = 25
-    rechoose_grasp_m: float = 0.05
-    rechoose_steps: int = 30
-    rechoose_looks: int = 2
-    rechoose_part_kind: bool = False
     max_step_m: float = 0.03
+    """Largest TCP translation per control step (m): a noisy estimate that jumps cannot throw the arm."""
     max_step_rad: float = 0.15
+    """Largest TCP rotation per control step (rad), for the same reason."""
     pos_tolerance: float = 0.012
+    """A move has reached its goal within this distance (m), about a quarter of a handle bar's reach."""
     rot_tolerance: float = 0.12
-    move_timeout: int = 60
+    """... and within this rotation (rad): the fingers still enclose a bar turned this much."""
+    timeout_steps: int = 60
+    """A move ends after this many steps whatever its error (the goal may be out of the arm's reach)."""
     blocked_steps: int = 6
-    approach_gap: float = 0.06
-    lid_max_tilt: float = 0.5
-    lid_approach_gap: float = 0.08
-    lid_edge_offset: float = 0.005
-    lid_wrist_follow: float = 0.0
-    lid_revolute_target: float = 2.0
-    lid_lift: bool = True
-    lid_lift_pitch: float = 1.3
-    lid_lift_below: float = 0.010
-    lid_lift_front: float = 0.06
-    lid_lift_under: float = 0.0
-    lid_lift_wrist_follow: float = 0.0
-    lid_lift_inward: float = 0.02
-    lid_lift_lead: float = 0.2
-    close_steps: int = 8
-    revolute_lead: float = 0.12
-    prismatic_lead: float = 0.03
-    wrist_follow: float = 0.5
-    revolute_target: float = 1.7
-    prismatic_target: float = 0.4
-    stall_progress: float = 0.02
-    stall_progress_m: float = 0.004
-    stall_steps: int = 12
-    slip_distance: float = 0.07
-    slip_steps: int = 8
-    lid_slip_off_axis: bool = True
-    hold_gap: float = 0.004
-    limit_slowdown: float = 0.8
-    limit_window: int = 2
-    limit_min_speed_m: float = 0.005
-    max_regrasps: int = 2
-    regrasp_other_fingers: bool = True
-    quarter_turn: bool = True
-    wrist_limit_margin: float = 0.05
-    retreat_distance: float = 0.08
-    fall_open_done: float = 1.3
-    revolute_stop_above: float = 1.4
-    prismatic_stop_above: float = 0.15
-    settle_above: float = 0.8
-    settle_clearance: float = 0.1
-    settle_window: int = 10
-    settle_progress: float = 0.06
-    settle_max_steps: int = 40
-    watch_falling: bool = True
-    release_steps: int = 6
-    arc_fit: bool = True
-    arc_fit_min_chord: float = 0.06
-    arc_fit_min_angle: float = 0.3
-    arc_fit_max_rms: float = 0.004
-    arc_fit_max_shift: float = 0.15
-    motion_axis: bool = False
-    motion_axis_min_travel: float = 0.03
-    motion_axis_min_angle: float = 0.4
-    motion_axis_max_rms: float = 0.004
-    motion_axis_max_turn: float = 0.6
-    motion_axis_max_ratio: float = 0.1
-    motion_axis_hinge_points: int = 6
-    rehearse_fingers: bool = True
-    rehearse_margin: float = 0.2
-    rehearse_track_m: float = 0.02
+    """A move ends when the TCP has not moved for this many steps: it touches something (a handle)."""
 
     def validate(self) -> None:
-        for key in ("pregrasp_offset", "max_step_m", "max_step_rad", "pos_tolerance", "rot_tolerance",
-                    "revolute_lead", "lid_lift_lead", "prismatic_lead", "stall_progress", "stall_progress_m",
-                    "revolute_target", "prismatic_target", "lid_revolute_target",
-                    "slip_distance", "hold_gap", "limit_min_speed_m", "arc_fit_min_chord",
-                    "arc_fit_min_angle", "arc_fit_max_rms", "arc_fit_max_shift", "settle_progress",
-                    "motion_axis_min_travel", "motion_axis_min_angle", "motion_axis_max_rms",
-                    "motion_axis_max_turn", "motion_axis_max_ratio"):
-            require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
-        require(0.0 < self.rehearse_margin <= 1.0,
-                f"rehearse_margin must be in (0, 1] (a share of the pull path), got {self.rehearse_margin}")
-        require(self.rehearse_track_m > 0, f"rehearse_track_m must be > 0 m, got {self.rehearse_track_m}")
+        _positive(self, "max_step_m", "max_step_rad", "pos_tolerance", "rot_tolerance", where="move.")
+        _at_least_one(self, "timeout_steps", "blocked_steps", where="move.")
+
+
+@dataclass(frozen=True)
+class ApproachConfig:
+    """The pre-grasp (outside the grasp point along the part's outward normal) and the approach (in
+    along the TCP's approach axis), for any part; per-kind pitches are in the kind's group."""
+
+    pregrasp_offset: float = 0.08
+    """Pre-grasp distance (m) outside the grasp point: the open fingers (8 cm long) clear the handle."""
+    grasp_depth: float = 0.01
+    """How far past the grasp point the approach goes (m), so the pads close round the bar, not its face."""
+    pitch: float = 0.55
+    """The approach points at least this far below horizontal (rad) for a hinged part other than a side
+    door, and for a part sliding across its face: a level Panda hand near the table is beyond its wrist
+    limits; a hand pitching with the part as it opens starts nearer level."""
+    gap: float = 0.06
+    """Finger gap while approaching (m; the Panda opens to 0.08): narrower keeps a pitched fingertip off
+    the surface a handle stands on; under 6 cm a finger pitched across a bar clips its edge when the grasp
+    point is half a centimetre off."""
+    rotate_first_above: float = 0.4
+    """The hand first turns in place while it is more than this far (rad) from the grasp orientation:
+    turned while travelling, the arm's IK reaches a low, far handle with the wrist at its joint limit and
+    cannot hold the pose while pulling."""
+    rotate_first_steps: int = 25
+    """... for at most this many steps (0: never)."""
+    rechoose_grasp_m: float = 0.05
+    """The grasp orientation is chosen again, the move starting over, when the perceived grasp point is
+    this far (m) from the one it was chosen for (0: never): a first look that finds no handle puts the
+    grasp point on the part's far edge, and an orientation chosen there does not suit the handle."""
+    rechoose_steps: int = 30
+    """... only in a grasp's first this many pre-grasp steps: an open part's grasp point jumps about from
+    look to look, and each start over turns the hand first."""
+    rechoose_looks: int = 2
+    """... and only when each of the last this many looks (new estimates) is that far off and they agree
+    with each other within ``rechoose_grasp_m``: a learned grasp point can jump for a single look."""
+    rechoose_part_kind: bool = False
+    """Also choose again, in those steps and on those looks, when the part's kind (lid, side door, other
+    hinge) differs from the one chosen for: a first look can tilt a door's hinge into a lid's."""
+
+    def validate(self) -> None:
+        _positive(self, "pregrasp_offset", where="approach.")
+        _angle(self.pitch, "approach.pitch")
+        require(0.0 < self.gap <= 0.08, f"approach.gap must be in (0, 0.08] m, got {self.gap}")
         require(self.rotate_first_above > 0,
-                f"rotate_first_above must be > 0 rad, got {self.rotate_first_above}")
-        require(self.rechoose_grasp_m >= 0,
-                f"rechoose_grasp_m must be >= 0 m (0: never), got {self.rechoose_grasp_m}")
-        require(self.rechoose_steps >= 0, f"rechoose_steps must be >= 0, got {self.rechoose_steps}")
-        require(self.rechoose_looks >= 1, f"rechoose_looks must be >= 1, got {self.rechoose_looks}")
-        require(self.motion_axis_hinge_points >= 4,
-                f"motion_axis_hinge_points must be >= 4, got {self.motion_axis_hinge_points}")
+                f"approach.rotate_first_above must be > 0 rad, got {self.rotate_first_above}")
         require(self.rotate_first_steps >= 0,
-                f"rotate_first_steps must be >= 0 (0: never), got {self.rotate_first_steps}")
-        for key in ("move_timeout", "blocked_steps", "close_steps", "stall_steps", "release_steps",
-                    "slip_steps", "limit_window", "settle_window", "settle_max_steps"):
-            require(getattr(self, key) >= 1, f"{key} must be >= 1, got {getattr(self, key)}")
-        require(0.0 < self.approach_gap <= 0.08,
-                f"approach_gap must be in (0, 0.08] m, got {self.approach_gap}")
-        for key in ("wrist_follow", "lid_wrist_follow", "lid_lift_wrist_follow"):
-            value = getattr(self, key)
-            require(0.0 <= value <= 1.0, f"{key} must be in [0, 1], got {value}")
-        require(0.0 < self.lid_approach_gap <= 0.08,
-                f"lid_approach_gap must be in (0, 0.08] m, got {self.lid_approach_gap}")
-        require(self.lid_edge_offset >= 0, f"lid_edge_offset must be >= 0 m, got {self.lid_edge_offset}")
-        require(0.0 < self.lid_lift_pitch <= 1.5,
-                f"lid_lift_pitch must be in (0, 1.5] rad, got {self.lid_lift_pitch}")
-        for key in ("lid_lift_below", "lid_lift_front", "lid_lift_under", "lid_lift_inward"):
-            require(getattr(self, key) >= 0, f"{key} must be >= 0 m, got {getattr(self, key)}")
+                f"approach.rotate_first_steps must be >= 0 (0: never), got {self.rotate_first_steps}")
+        require(self.rechoose_grasp_m >= 0,
+                f"approach.rechoose_grasp_m must be >= 0 m (0: never), got {self.rechoose_grasp_m}")
+        require(self.rechoose_steps >= 0, f"approach.rechoose_steps must be >= 0, got {self.rechoose_steps}")
+        require(self.rechoose_looks >= 1, f"approach.rechoose_looks must be >= 1, got {self.rechoose_looks}")
+
+
+@dataclass(frozen=True)
+class GraspConfig:
+    """Closing the fingers, telling a hold from an empty hand, and choosing the finger order."""
+
+    close_steps: int = 8
+    """Steps the gripper takes to close (the Panda's fingers close in about 0.3 s)."""
+    hold_gap: float = 0.004
+    """Fingers at least this far apart (m) hold something; closed on nothing they touch (about 0)."""
+    rehearse_fingers: bool = True
+    """Rehearse both finger orders of a grasp (not a lid's) on the Panda's kinematic model
+    (:mod:`agents.scripted.grasp_rehearsal`) and take the one farther from the hand's rotation only if
+    it reaches the grasp and follows the whole pull while the nearer one does not: one order can leave a
+    wrist joint at its limit."""
+    rehearse_margin: float = 0.2
+    """... the nearer order is given up only if it falls behind before ``1 - margin`` of the pull path
+    (a share in (0, 1]): when both fall behind late, the model cannot tell them apart."""
+    rehearse_track_m: float = 0.02
+    """A rehearsed TCP farther than this (m) from the pull path has fallen behind."""
+
+    def validate(self) -> None:
+        _positive(self, "hold_gap", "rehearse_track_m", where="grasp.")
+        _at_least_one(self, "close_steps", where="grasp.")
+        require(0.0 < self.rehearse_margin <= 1.0,
+                f"grasp.rehearse_margin must be in (0, 1] (a share of the pull path), "
+                f"got {self.rehearse_margin}")
+
+
+@dataclass(frozen=True)
+class ArcFitConfig:
+    """The hinge measured by the hand that holds its part: once the holding hand's path is long enough,
+    the centre of the circle it follows about the estimated axis direction replaces the estimated pivot
+    for the rest of the pull. A pivot a few cm off the hinge of a 20 cm door reads the swept angle
+    0.4 rad too large, and the hand lets go short of open."""
+
+    enabled: bool = True
+    min_chord: float = 0.06
+    """The path must span this much (m) before a circle is fitted: shorter arcs fit any centre."""
+    min_angle: float = 0.3
+    """... and sweep this much (rad) about the estimated hinge."""
+    max_rms: float = 0.004
+    """The path must lie within this (m, RMS) of the circle: a hand slipping along the handle does not."""
+    max_shift: float = 0.15
+    """The fitted centre must lie within this (m) of the estimated hinge line: farther is another motion."""
+
+    def validate(self) -> None:
+        _positive(self, "min_chord", "min_angle", "max_rms", "max_shift", where="pull.arc_fit.")
+
+
+@dataclass(frozen=True)
+class MotionAxisConfig:
+    """The axis measured by how the part moved (:func:`agents.scripted.motion_axis.fit_motion_axis`): the
+    estimated grasp points seen while the fingers held the part (every pull of the episode) are fitted
+    with a line (prismatic) or a circle in a plane (revolute), and a good fit replaces the estimated axis
+    for the rest of the episode. An axis a few degrees off makes the commanded arc or line leave the
+    part's own, and the fingers slide off it. Off by default."""
+
+    enabled: bool = False
+    min_travel: float = 0.03
+    """The points must spread this far (m) before a fit."""
+    min_angle: float = 0.4
+    """A circle must sweep this much (rad)."""
+    max_rms: float = 0.004
+    """Points within this (m, RMS) of the fit."""
+    max_turn: float = 0.6
+    """The fitted axis within this (rad) of the estimated one: farther is a fit to noise."""
+    max_ratio: float = 0.1
+    """The points' spread off the line or plane at most this share of their spread along it."""
+    hinge_points: int = 6
+    """Points a circle needs (a plane and a circle through 4 fit anything; a line needs 3)."""
+
+    def validate(self) -> None:
+        _positive(self, "min_travel", "min_angle", "max_rms", "max_turn", "max_ratio",
+                  where="pull.motion_axis.")
+        require(self.hinge_points >= 4,
+                f"pull.motion_axis.hinge_points must be >= 4, got {self.hinge_points}")
+
+
+@dataclass(frozen=True)
+class RevolutePullConfig:
+    """Pulling a hinged part (lids have their own target, ``lid.target``)."""
+
+    lead: float = 0.12
+    """The commanded TCP leads the part by this angle (rad) along its arc: the pull's force."""
+    target: float = 1.7
+    """The pull ends when the hand's measure of the part's angle reaches this (rad)."""
+    stall_progress: float = 0.02
+    """A pull that turned less than this (rad) over ``pull.stall_steps`` has stalled (a limit, a lost
+    grip)."""
+    wrist_follow: float = 0.5
+    """The hand turns by this share of the part's angle about a hinge that is not vertical (a side door's
+    hand turns fully): a grasped bar turns between the pads, and a hand turned fully with an oven door
+    reaches the Panda's wrist limit."""
+    stop_above: float = 1.4
+    """A hinged part (not a lid nor a door that falls open) whose pull stalls past this angle (rad), the
+    fingers holding and no wrist joint at its limit, is at its end stop and is not grasped again (0:
+    off): reaching for its handle again knocks it back towards closed."""
+
+    def validate(self) -> None:
+        _positive(self, "lead", "target", "stall_progress", where="pull.revolute.")
+        _share(self, "wrist_follow", where="pull.revolute.")
+        _non_negative(self, "stop_above", where="pull.revolute.", note=" rad (0: off)")
+
+
+@dataclass(frozen=True)
+class PrismaticPullConfig:
+    """Pulling a sliding part (drawers and sliding panels)."""
+
+    lead: float = 0.03
+    """The commanded TCP leads the part by this distance (m) along its axis."""
+    target: float = 0.4
+    """The pull ends when the hand has pulled the part this far out (m)."""
+    stall_progress: float = 0.004
+    """A pull that moved less than this (m) over ``pull.stall_steps`` has stalled."""
+    limit_slowdown: float = 0.8
+    """The part is at its end stop when the pulling hand moves less than this share of its cruising speed
+    for ``limit_window`` steps: pulled on, the handle slides out of the fingers and a re-grasp chases an
+    open part. A handle gripped pitched slides out early, the hand slowing only to 0.6-0.8 of its speed."""
+    limit_window: int = 2
+    """Steps the hand must stay slowed."""
+    limit_min_speed_m: float = 0.005
+    """The cruising speed (median step, m) must be at least this for a slowdown to count."""
+    stop_above: float = 0.15
+    """A slip from a part the hand has pulled past this (m) also ends the pull for good (0: off): the
+    handle slid out at the end stop before the slowdown was read, and a re-grasp's approach would push
+    the open part back in."""
+
+    def validate(self) -> None:
+        _positive(self, "lead", "target", "stall_progress", "limit_min_speed_m", where="pull.prismatic.")
+        _at_least_one(self, "limit_window", where="pull.prismatic.")
         require(0.0 < self.limit_slowdown < 1.0,
-                f"limit_slowdown must be in (0, 1), got {self.limit_slowdown}")
-        require(self.max_regrasps >= 0, "max_regrasps must be >= 0")
-        require(self.fall_open_done >= 0,
-                f"fall_open_done must be >= 0 rad (0: off), got {self.fall_open_done}")
-        require(self.revolute_stop_above >= 0,
-                f"revolute_stop_above must be >= 0 rad (0: off), got {self.revolute_stop_above}")
-        require(0.0 <= self.slide_across_min_angle <= np.pi,
-                f"slide_across_min_angle must be in [0, pi] rad (past pi/2: never), "
-                f"got {self.slide_across_min_angle}")
-        require(0.0 <= self.hold_rising_above <= 1.5,
-                f"hold_rising_above must be in [0, 1.5] rad (0: off), got {self.hold_rising_above}")
-        require(self.prismatic_stop_above >= 0,
-                f"prismatic_stop_above must be >= 0 m (0: off), got {self.prismatic_stop_above}")
-        require(self.settle_above >= 0, f"settle_above must be >= 0 rad, got {self.settle_above}")
-        require(self.settle_clearance >= 0,
-                f"settle_clearance must be >= 0 m, got {self.settle_clearance}")
+                f"pull.prismatic.limit_slowdown must be in (0, 1), got {self.limit_slowdown}")
+        _non_negative(self, "stop_above", where="pull.prismatic.", note=" m (0: off)")
+
+
+@dataclass(frozen=True)
+class PullConfig:
+    """Moving the held part along its estimated arc or line, measured by the hand's own travel."""
+
+    stall_steps: int = 12
+    """Progress is measured over this many steps (0.6 s: longer than a perception period)."""
+    slip_distance: float = 0.07
+    """The hand has slipped off when it stays farther than this (m) from the perceived grasp point ..."""
+    slip_steps: int = 8
+    """... for this many steps (longer than a perception period: one bad estimate, e.g. of a handle the
+    hand now hides, is not a slip) with its fingers closed on nothing (a gap means they still hold)."""
+    revolute: RevolutePullConfig = field(default_factory=RevolutePullConfig)
+    prismatic: PrismaticPullConfig = field(default_factory=PrismaticPullConfig)
+    arc_fit: ArcFitConfig = field(default_factory=ArcFitConfig)
+    motion_axis: MotionAxisConfig = field(default_factory=MotionAxisConfig)
+
+    def validate(self) -> None:
+        _positive(self, "slip_distance", where="pull.")
+        _at_least_one(self, "stall_steps", "slip_steps", where="pull.")
+        for sub in (self.revolute, self.prismatic, self.arc_fit, self.motion_axis):
+            sub.validate()
+
+
+@dataclass(frozen=True)
+class ReleaseConfig:
+    """Letting go and backing off."""
+
+    steps: int = 6
+    """Steps the gripper takes to open."""
+    retreat_distance: float = 0.08
+    """The open hand backs off this far (m) along its approach axis: the fingers clear the handle."""
+
+    def validate(self) -> None:
+        _at_least_one(self, "steps", where="release.")
+        _non_negative(self, "retreat_distance", where="release.", note=" m")
+
+
+@dataclass(frozen=True)
+class RecoveryConfig:
+    """Grasping again after a miss, a slip or a stall."""
+
+    max_regrasps: int = 2
+    """Grasps after the first, at most (a pull that slips or stalls short of its target, fingers that
+    close on nothing)."""
+    other_fingers: bool = True
+    """Fingers that close on nothing (not a lid's) open, back off and grasp again with the fingers the
+    other way round: for a low handle one of the two finger orders can leave a wrist joint at its limit
+    short of the handle."""
+    quarter_turn: bool = True
+    """... that is so only when the approach timed out or a wrist joint is at its limit; otherwise the
+    hand reached the handle and it does not lie across the fingers (a lever bar at right angles to the
+    hinge), so this and later grasps turn the fingers a quarter turn about the approach."""
+    wrist_limit_margin: float = 0.05
+    """A wrist joint (5, 6, 7) within this (rad) of its limit is at it (0: off). A pull that stalls so
+    grasps again with the fingers the other way round: the arm ran out of range with this order."""
+
+    def validate(self) -> None:
+        require(self.max_regrasps >= 0, "recovery.max_regrasps must be >= 0")
         require(0.0 <= self.wrist_limit_margin < 0.5,
-                f"wrist_limit_margin must be in [0, 0.5) rad (0: off), got {self.wrist_limit_margin}")
-        for key in ("approach_pitch", "prismatic_approach_pitch", "vertical_hinge_pitch",
-                    "vertical_hinge_max_tilt", "lid_max_tilt"):
-            value = getattr(self, key)
-            require(0 <= value <= 1.5, f"{key} must be in [0, 1.5] rad, got {value}")
+                f"recovery.wrist_limit_margin must be in [0, 0.5) rad (0: off), "
+                f"got {self.wrist_limit_margin}")
+
+
+@dataclass(frozen=True)
+class SideDoorConfig:
+    """A door hinged about a near-vertical axis: the hand only yaws while pulling, so it turns fully with
+    the door and can start pitched further down."""
+
+    max_tilt: float = 0.8
+    """A hinge within this (rad) of vertical is a side door's."""
+    pitch: float = 0.8
+    """The approach points at least this far below horizontal (rad)."""
+
+    def validate(self) -> None:
+        _angle(self.max_tilt, "side_door.max_tilt")
+        _angle(self.pitch, "side_door.pitch")
+
+
+@dataclass(frozen=True)
+class LidLiftConfig:
+    """Lifting a lid from below when the fingers closed on nothing across its lip (wider than the open
+    fingers): the closed fingertips, pointing at the hinge and steeply down, slide in under the lip and
+    push it open along its arc, carrying its weight."""
+
+    enabled: bool = True
+    pitch: float = 1.3
+    """The closed fingers point at the hinge this far below horizontal (rad)."""
+    below: float = 0.010
+    """The fingertips go this far (m) under the grasp point ..."""
+    front: float = 0.06
+    """... from this far (m) in front of it (where the hand lines up) ..."""
+    under: float = 0.0
+    """... to this far (m) behind it (where the hand slides to)."""
+    wrist_follow: float = 0.0
+    """The hand turns by this share of the lid's angle."""
+    inward: float = 0.02
+    """The hand moves this far (m) towards the hinge per radian the lid has turned: on an estimated hinge
+    1-2 cm off, fingertips following its arc slide off the lip; sliding towards the hinge they stay
+    under it."""
+    lead: float = 0.2
+    """The push leads the lid by this angle (rad): pushing from below, the fingertips carry its weight,
+    and a larger lead pushes through the stall near 0.4 rad that ``pull.revolute.lead`` meets."""
+
+    def validate(self) -> None:
+        _positive(self, "lead", where="lid.lift.")
+        require(0.0 < self.pitch <= 1.5, f"lid.lift.pitch must be in (0, 1.5] rad, got {self.pitch}")
+        _non_negative(self, "below", "front", "under", "inward", where="lid.lift.", note=" m")
+        _share(self, "wrist_follow", where="lid.lift.")
+
+
+@dataclass(frozen=True)
+class LidConfig:
+    """A revolute part whose grasp point opens upwards (a closed laptop): gripped from above, the fingers
+    closing along the hinge across its front lip."""
+
+    max_tilt: float = 0.5
+    """A part whose grasp point opens within this (rad) of straight up is a lid."""
+    gap: float = 0.08
+    """Finger gap while approaching (m): fully open, to take the lip's thickness and the estimate's error."""
+    edge_offset: float = 0.005
+    """The grip is this far (m) beyond the grasp point away from the hinge, so the pads clear the lid's
+    edge whether the grasp point is the lip's centre or the outer band of its points."""
+    wrist_follow: float = 0.0
+    """The hand turns by this share of the lid's angle: the pinch lets the lip turn between the pads, and a
+    hand turned with the lid would point back at the robot."""
+    target: float = 2.0
+    """The pull ends at this angle (rad), past upright, so the lid does not rest on its hinge's friction
+    just short of the success angle."""
+    slip_off_axis: bool = True
+    """A lid's slip distance leaves out its component along the hinge: a lid has no handle, and its grasp
+    point (the middle of the far edge's visible points) slides along the edge as the hand hides part of it."""
+    lift: LidLiftConfig = field(default_factory=LidLiftConfig)
+
+    def validate(self) -> None:
+        _angle(self.max_tilt, "lid.max_tilt")
+        require(0.0 < self.gap <= 0.08, f"lid.gap must be in (0, 0.08] m, got {self.gap}")
+        _non_negative(self, "edge_offset", where="lid.", note=" m")
+        _share(self, "wrist_follow", where="lid.")
+        _positive(self, "target", where="lid.")
+        self.lift.validate()
+
+
+@dataclass(frozen=True)
+class FallingDoorConfig:
+    """A door that gravity opens further once let go (hinged below its grasp point about a non-vertical
+    axis, not a lid: an oven door). Reaching for the handle of a door near level pushes it back, so such
+    a door is left to fall and watched rather than grasped again."""
+
+    done_above: float = 1.3
+    """A pull that ends (stall or slip) past this angle (rad), by both the hand's measure and the perceived
+    state, is not followed by a grasp (0: every falling-door rule off)."""
+    settle_above: float = 0.8
+    """Let go past this angle (rad), the open hand clears the door's sweep and waits while it falls; a
+    door let go nearer closed falls too slowly to wait for."""
+    clearance: float = 0.1
+    """While waiting, the hand moves this far (m) beyond the grasp radius about the hinge (out of the
+    door's sweep)."""
+    window: int = 10
+    """The door is still falling while its perceived state rose by ``progress`` over this many steps."""
+    progress: float = 0.06
+    """... by this much (rad); a door that creeps is grasped again."""
+    max_steps: int = 40
+    """Waiting ends after this many steps."""
+    watch: bool = True
+    """Such a door seen falling open before it is grasped (at least ``settle_above`` open and rising: the
+    hand turning in front of it brushed it, or it was let go short of open) is not reached for: the hand
+    clears its sweep and waits the same way."""
+
+    def validate(self) -> None:
+        _non_negative(self, "done_above", where="falling_door.", note=" rad (0: off)")
+        _non_negative(self, "settle_above", where="falling_door.", note=" rad")
+        _non_negative(self, "clearance", where="falling_door.", note=" m")
+        _positive(self, "progress", where="falling_door.")
+        _at_least_one(self, "window", "max_steps", where="falling_door.")
+
+
+@dataclass(frozen=True)
+class DrawerConfig:
+    """A sliding part that comes out of the face its handle is on, towards the robot."""
+
+    pitch: float = 0.3
+    """The approach points at least this far below horizontal (rad): a drawer's bar is pulled along the
+    approach, and fingers pitched further squeeze it out along the pull; a handle near the table
+    approached steeper runs wrist joint 5 into its limit."""
+
+    def validate(self) -> None:
+        _angle(self.pitch, "drawer.pitch")
+
+
+@dataclass(frozen=True)
+class SlidingPanelConfig:
+    """A sliding part that slides across the face its handle is on (a window sliding up, a sliding door):
+    approached square on from the robot's side, the fingers closing along the slide, pulled along its
+    axis whatever way that points."""
+
+    min_angle: float = 0.785
+    """A prismatic axis more than this (rad) from the horizontal direction to the robot's base slides
+    across its face (past pi/2: never)."""
+    hold_rising_above: float = 0.3
+    """A part whose opening direction rises more than this (rad) above horizontal is held where the pull
+    ended, not let go: gravity would slide it back closed (0: off)."""
+
+    def validate(self) -> None:
+        require(0.0 <= self.min_angle <= np.pi,
+                f"sliding_panel.min_angle must be in [0, pi] rad (past pi/2: never), got {self.min_angle}")
+        require(0.0 <= self.hold_rising_above <= 1.5,
+                f"sliding_panel.hold_rising_above must be in [0, 1.5] rad (0: off), "
+                f"got {self.hold_rising_above}")
+
+
+@dataclass(frozen=True)
+class ScriptedOpenerConfig:
+    """Options of :class:`agents.scripted.opener.ScriptedOpener`, one group per part of the method or
+    part kind (see the module docstring)."""
+
+    move: MoveConfig = field(default_factory=MoveConfig)
+    approach: ApproachConfig = field(default_factory=ApproachConfig)
+    grasp: GraspConfig = field(default_factory=GraspConfig)
+    pull: PullConfig = field(default_factory=PullConfig)
+    release: ReleaseConfig = field(default_factory=ReleaseConfig)
+    recovery: RecoveryConfig = field(default_factory=RecoveryConfig)
+    side_door: SideDoorConfig = field(default_factory=SideDoorConfig)
+    lid: LidConfig = field(default_factory=LidConfig)
+    falling_door: FallingDoorConfig = field(default_factory=FallingDoorConfig)
+    drawer: DrawerConfig = field(default_factory=DrawerConfig)
+    sliding_panel: SlidingPanelConfig = field(default_factory=SlidingPanelConfig)
+
+    def validate(self) -> None:
+        for f in fields(self):
+            getattr(self, f.name).validate()
+
+    @classmethod
+    def upgrade_legacy_keys(cls, data: dict[str, Any], where: str = "config") -> dict[str, Any]:
+        """Hook of :func:`capt_common.typed_yaml.from_dict`: see :func:`upgrade_legacy_keys`."""
+        return upgrade_legacy_keys(data, where)
+
+
+# The flat option names of earlier releases and where each lives now (deprecated; to be removed in
+# the release after next). One table: loading, the warning and ``legacy_value`` all read it.
+LEGACY_KEYS: dict[str, str] = {
+    "max_step_m": "move.max_step_m",
+    "max_step_rad": "move.max_step_rad",
+    "pos_tolerance": "move.pos_tolerance",
+    "rot_tolerance": "move.rot_tolerance",
+    "move_timeout": "move.timeout_steps",
+    "blocked_steps": "move.blocked_steps",
+    "pregrasp_offset": "approach.pregrasp_offset",
+    "grasp_depth": "approach.grasp_depth",
+    "approach_pitch": "approach.pitch",
+    "approach_gap": "approach.gap",
+    "rotate_first_above": "approach.rotate_first_above",
+    "rotate_first_steps": "approach.rotate_first_steps",
+    "rechoose_grasp_m": "approach.rechoose_grasp_m",
+    "rechoose_steps": "approach.rechoose_steps",
+    "rechoose_looks": "approach.rechoose_looks",
+    "rechoose_part_kind": "approach.rechoose_part_kind",
+    "close_steps": "grasp.close_steps",
+    "hold_gap": "grasp.hold_gap",
+    "rehearse_fingers": "grasp.rehearse_fingers",
+    "rehearse_margin": "grasp.rehearse_margin",
+    "rehearse_track_m": "grasp.rehearse_track_m",
+    "stall_steps": "pull.stall_steps",
+    "slip_distance": "pull.slip_distance",
+    "slip_steps": "pull.slip_steps",
+    "revolute_lead": "pull.revolute.lead",
+    "revolute_target": "pull.revolute.target",
+    "stall_progress": "pull.revolute.stall_progress",
+    "wrist_follow": "pull.revolute.wrist_follow",
+    "revolute_stop_above": "pull.revolute.stop_above",
+    "prismatic_lead": "pull.prismatic.lead",
+    "prismatic_target": "pull.prismatic.target",
+    "stall_progress_m": "pull.prismatic.stall_progress",
+    "limit_slowdown": "pull.prismatic.limit_slowdown",
+    "limit_window": "pull.prismatic.limit_window",
+    "limit_min_speed_m": "pull.prismatic.limit_min_speed_m",
+    "prismatic_stop_above": "pull.prismatic.stop_above",
+    "arc_fit": "pull.arc_fit.enabled",
+    "arc_fit_min_chord": "pull.arc_fit.min_chord",
+    "arc_fit_min_angle": "pull.arc_fit.min_angle",
+    "arc_fit_max_rms": "pull.arc_fit.max_rms",
+    "arc_fit_max_shift": "pull.arc_fit.max_shift",
+    "motion_axis": "pull.motion_axis.enabled",
+    "motion_axis_min_travel": "pull.motion_axis.min_travel",
+    "motion_axis_min_angle": "pull.motion_axis.min_angle",
+    "motion_axis_max_rms": "pull.motion_axis.max_rms",
+    "motion_axis_max_turn": "pull.motion_axis.max_turn",
+    "motion_axis_max_ratio": "pull.motion_axis.max_ratio",
+    "motion_axis_hinge_points": "pull.motion_axis.hinge_points",
+    "release_steps": "release.steps",
+    "retreat_distance": "release.retreat_distance",
+    "max_regrasps": "recovery.max_regrasps",
+    "regrasp_other_fingers": "recovery.other_fingers",
+    "quarter_turn": "recovery.quarter_turn",
+    "wrist_limit_margin": "recovery.wrist_limit_margin",
+    "vertical_hinge_max_tilt": "side_door.max_tilt",
+    "vertical_hinge_pitch": "side_door.pitch",
+    "lid_max_tilt": "lid.max_tilt",
+    "lid_approach_gap": "lid.gap",
+    "lid_edge_offset": "lid.edge_offset",
+    "lid_wrist_follow": "lid.wrist_follow",
+    "lid_revolute_target": "lid.target",
+    "lid_slip_off_axis": "lid.slip_off_axis",
+    "lid_lift": "lid.lift.enabled",
+    "lid_lift_pitch": "lid.lift.pitch",
+    "lid_lift_below": "lid.lift.below",
+    "lid_lift_front": "lid.lift.front",
+    "lid_lift_under": "lid.lift.under",
+    "lid_lift_wrist_follow": "lid.lift.wrist_follow",
+    "lid_lift_inward": "lid.lift.inward",
+    "lid_lift_lead": "lid.lift.lead",
+    "fall_open_done": "falling_door.done_above",
+    "settle_above": "falling_door.settle_above",
+    "settle_clearance": "falling_door.clearance",
+    "settle_window": "falling_door.window",
+    "settle_progress": "falling_door.progress",
+    "settle_max_steps": "falling_door.max_steps",
+    "watch_falling": "falling_door.watch",
+    "prismatic_approach_pitch": "drawer.pitch",
+    "slide_across_min_angle": "sliding_panel.min_angle",
+    "hold_rising_above": "sliding_panel.hold_rising_above",
+}
+
+
+def upgrade_legacy_keys(data: dict[str, Any], where: str = "config") -> dict[str, Any]:
+    """``data`` (a mapping for :class:`ScriptedOpenerConfig`) with its flat keys of earlier releases
+    moved to their nested places (:data:`LEGACY_KEYS`), warning (``FutureWarning``) once per mapping that
+    names them; a key given both ways is an error. Other keys are left for the strict loader to check."""
+    legacy = [key for key in data if key in LEGACY_KEYS]
+    if not legacy:
+        return data
+    warnings.warn(f"{where}: flat scripted-opener keys are deprecated, use the nested ones: "
+                  + ", ".join(f"{key} -> {LEGACY_KEYS[key]}" for key in legacy), FutureWarning, stacklevel=3)
+    out: dict[str, Any] = {k: v for k, v in data.items() if k not in LEGACY_KEYS}
+    for key in legacy:
+        *groups, leaf = LEGACY_KEYS[key].split(".")
+        node = out
+        for group in groups:
+            child = node.get(group)
+            child = {} if child is None else dict(child) if isinstance(child, dict) else child
+            require(isinstance(child, dict), f"{where}.{group}: expected a mapping, got {child!r}")
+            node[group] = child
+            node = child
+        require(leaf not in node, f"{where}: {key} and {LEGACY_KEYS[key]} both given")
+        node[leaf] = data[key]
+    return out
+
+
+def legacy_value(config: ScriptedOpenerConfig, key: str) -> Any:
+    """The value of flat option ``key`` of earlier releases (or of a dotted path) in ``config``."""
+    node: Any = config
+    for part in LEGACY_KEYS.get(key, key).split("."):
+        node = getattr(node, part)
+    return node
+
+
+def with_options(config: ScriptedOpenerConfig, **changes: Any) -> ScriptedOpenerConfig:
+    """``config`` with options changed, named by their dotted path with ``__`` for the dots
+    (``with_options(cfg, lid__lift__inward=0.0)``) or by their flat name of earlier releases."""
+    from dataclasses import replace
+
+    def put(node: Any, path: list[str], value: Any) -> Any:
+        if len(path) == 1:
+            return replace(node, **{path[0]: value})
+        return replace(node, **{path[0]: put(getattr(node, path[0]), path[1:], value)})
+
+    for key, value in changes.items():
+        dotted = LEGACY_KEYS.get(key, key.replace("__", "."))
+        config = put(config, dotted.split("."), value)
+    assert is_dataclass(config)
+    config.validate()
+    return config

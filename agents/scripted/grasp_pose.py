@@ -30,7 +30,7 @@ def slides_across_face(est: JointAxisEstimate, cfg: ScriptedOpenerConfig,
                        robot_side: np.ndarray | None) -> bool:
     """Whether ``est`` is a prismatic part that slides across the face its handle is on (a window
     sliding up, a sliding door sliding sideways) rather than out of it towards the hand (a drawer):
-    its axis is more than ``slide_across_min_angle`` rad from ``robot_side`` (3,), the horizontal
+    its axis is more than ``sliding_panel.min_angle`` rad from ``robot_side`` (3,), the horizontal
     direction from the grasp point to the robot's base. The robot sees and reaches the object from
     that side, so a handle stands off the face turned to it; a part whose axis points there comes out
     of that face, one whose axis lies across it slides in it. False without ``robot_side``."""
@@ -39,7 +39,7 @@ def slides_across_face(est: JointAxisEstimate, cfg: ScriptedOpenerConfig,
     side = perpendicular(UP, np.asarray(robot_side, dtype=np.float64))
     if side is None:
         return False
-    return float(unit(est.direction) @ side) < float(np.cos(cfg.slide_across_min_angle))
+    return float(unit(est.direction) @ side) < float(np.cos(cfg.sliding_panel.min_angle))
 
 
 def approach_normal(est: JointAxisEstimate, cfg: ScriptedOpenerConfig,
@@ -57,18 +57,18 @@ def approach_normal(est: JointAxisEstimate, cfg: ScriptedOpenerConfig,
 
 
 def is_vertical_hinge(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
-    """Whether ``est`` is a revolute joint whose axis is within ``vertical_hinge_max_tilt`` of vertical."""
+    """Whether ``est`` is a revolute joint whose axis is within ``side_door.max_tilt`` of vertical."""
     if est.joint_type != "revolute":
         return False
-    return abs(float(unit(est.direction)[2])) >= float(np.cos(cfg.vertical_hinge_max_tilt))
+    return abs(float(unit(est.direction)[2])) >= float(np.cos(cfg.side_door.max_tilt))
 
 
 def is_lid(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> bool:
     """Whether ``est`` is a revolute part that opens upwards at its grasp point, within
-    ``lid_max_tilt`` rad of straight up (a closed lid: the hand comes down from above)."""
+    ``lid.max_tilt`` rad of straight up (a closed lid: the hand comes down from above)."""
     if est.joint_type != "revolute":
         return False
-    return float(outward_normal(est)[2]) >= float(np.cos(cfg.lid_max_tilt))
+    return float(outward_normal(est)[2]) >= float(np.cos(cfg.lid.max_tilt))
 
 
 def part_kind(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> str:
@@ -102,28 +102,28 @@ def lid_frame(est: JointAxisEstimate) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def grasp_target(est: JointAxisEstimate, cfg: ScriptedOpenerConfig) -> np.ndarray:
-    """World point (3,) the TCP grips: the grasp point, moved ``lid_edge_offset`` m further from the
+    """World point (3,) the TCP grips: the grasp point, moved ``lid.edge_offset`` m further from the
     hinge on a lid (the fingers then pinch the front of the lip and clear the lid's edge)."""
     frame = lid_frame(est) if is_lid(est, cfg) else None
-    return est.grasp_point if frame is None else est.grasp_point + cfg.lid_edge_offset * frame[0]
+    return est.grasp_point if frame is None else est.grasp_point + cfg.lid.edge_offset * frame[0]
 
 
 def lift_pose(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig,
               under: bool) -> tuple[np.ndarray, np.ndarray] | None:
     """TCP goal (position (3,) m, rotation (3, 3)), world frame, for lifting a lid from below: the
-    closed fingertips, pointing at the hinge and ``lid_lift_pitch`` rad down, go
-    ``lid_lift_below`` m under the grasp point, ``lid_lift_front`` m in front of it (``under`` False:
-    where the hand lines up) or ``lid_lift_under`` m behind it (``under`` True: where it slides to).
+    closed fingertips, pointing at the hinge and ``lid.lift.pitch`` rad down, go
+    ``lid.lift.below`` m under the grasp point, ``lid.lift.front`` m in front of it (``under`` False:
+    where the hand lines up) or ``lid.lift.under`` m behind it (``under`` True: where it slides to).
     For a lip wider than the open fingers."""
     frame = lid_frame(est)
     if frame is None:
         return None
     front, up = frame
-    approach = -np.cos(cfg.lid_lift_pitch) * front - np.sin(cfg.lid_lift_pitch) * up
+    approach = -np.cos(cfg.lid.lift.pitch) * front - np.sin(cfg.lid.lift.pitch) * up
     # front, up and the hinge are orthonormal; the fingers close along the hinge
     rot = nearer_finger_order(grasp_frame(approach, unit(est.direction)), current)
-    ahead = -cfg.lid_lift_under if under else cfg.lid_lift_front
-    return est.grasp_point + ahead * front - cfg.lid_lift_below * up, rot
+    ahead = -cfg.lid.lift.under if under else cfg.lid.lift.front
+    return est.grasp_point + ahead * front - cfg.lid.lift.below * up, rot
 
 
 def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpenerConfig,
@@ -155,13 +155,13 @@ def grasp_rotation(est: JointAxisEstimate, current: np.ndarray, cfg: ScriptedOpe
     elevation = float(np.arcsin(np.clip(approach[2], -1.0, 1.0)))
     horizontal = perpendicular(approach, UP)
     if is_vertical_hinge(est, cfg):
-        pitch = cfg.vertical_hinge_pitch
+        pitch = cfg.side_door.pitch
     elif est.joint_type == "prismatic" and not slides_across_face(est, cfg, robot_side):
         # a drawer's bar is pulled along the approach: pitched further, the tilted fingers squeeze
         # it out along the pull (see the config); a part sliding across the approach is not
-        pitch = cfg.prismatic_approach_pitch
+        pitch = cfg.drawer.pitch
     else:
-        pitch = cfg.approach_pitch
+        pitch = cfg.approach.pitch
     if elevation > -pitch and horizontal is not None:
         # point the hand down by turning about the horizontal axis across the approach: the Panda's
         # wrist cannot point level at table height, and a handle bar stays between the fingers

@@ -9,6 +9,7 @@ import numpy as np
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
 from agents.scripted.failure_cause import CAUSES, count_causes, failure_cause
 from agents.scripted.opener import Phase
+from agents.scripted.phases.grasp import Close
 from capt_env.wrappers.estimate import JointAxisEstimate
 
 
@@ -77,8 +78,8 @@ def test_the_opener_logs_each_phase_and_whether_its_pull_holds() -> None:
     opener = ScriptedOpener(cfg)
     pose = np.array([-0.2, 0.0, 0.3, 0.0, 1.0, 0.0, 0.0])
     opener.act_on(est, pose)
-    opener._set(Phase.CLOSE, "reached")
-    for _ in range(cfg.close_steps):
+    opener.enter(Close("reached"))
+    for _ in range(cfg.grasp.close_steps):
         opener.act_on(est, pose, finger_gap=0.02)
     assert opener.phase == Phase.PULL and opener.phase_log[-1]["grip"] == "none"
     opener.act_on(est, pose, finger_gap=0.02)
@@ -86,4 +87,4 @@ def test_the_opener_logs_each_phase_and_whether_its_pull_holds() -> None:
     opener.act_on(est, pose, finger_gap=0.0)  # the fingers closed on nothing: the handle slid out
     assert opener.phase_log[-1]["grip"] == "lost"
     assert [e["phase"] for e in opener.phase_log] == ["pregrasp", "close", "pull"]
-    assert opener.phase_log[-1]["step"] == 1 + cfg.close_steps
+    assert opener.phase_log[-1]["step"] == 1 + cfg.grasp.close_steps

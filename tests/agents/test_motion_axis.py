@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from agents.scripted.config import ScriptedOpenerConfig
+from agents.scripted.config import ScriptedOpenerConfig, with_options
 from agents.scripted.geometry import axis_angle_matrix
 from agents.scripted.motion_axis import fit_motion_axis
 from agents.scripted.opener import ScriptedOpener
@@ -65,7 +65,7 @@ def _drawer_episode(motion_axis: bool) -> tuple[bool, float, ScriptedOpener]:
     noise = {"model": "fixed_offset", "direction_rad": float(np.radians(10.0)), "pivot_m": 0.0,
              "state": 0.0, "grasp_m": 0.0}
     env = make_env("drawer_cabinet", {"source": "noisy_oracle", "every_k_steps": 5, "noise": noise})
-    opener = ScriptedOpener(ScriptedOpenerConfig(motion_axis=motion_axis))
+    opener = ScriptedOpener(with_options(ScriptedOpenerConfig(), pull__motion_axis__enabled=motion_axis))
     try:
         result = run_episode(env, opener, seed=0, max_steps=140)
     finally:
@@ -79,4 +79,5 @@ def test_a_drawer_10_degrees_off_opens_once_its_motion_gives_the_axis() -> None:
     assert not opened and fraction < 0.5
     opened, fraction, opener = _drawer_episode(motion_axis=True)
     assert opened and fraction > 0.9
-    assert opener._motion is not None and opener._motion.turn == pytest.approx(np.radians(10.0), abs=0.01)
+    motion = opener.ctx.axis.motion
+    assert motion is not None and motion.turn == pytest.approx(np.radians(10.0), abs=0.01)

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
+from agents.scripted.config import LEGACY_KEYS, legacy_value, with_options
 from agents.scripted.geometry import axis_angle_matrix, fit_circle, swept_angle
 from agents.scripted.grasp_pose import (
     falls_open,
@@ -21,10 +24,29 @@ from agents.scripted.grasp_pose import (
 )
 from agents.scripted.opener import ACTION_SCALE_M, Phase
 from agents.scripted.panda_kinematics import tcp_pose
+from agents.scripted.phases.base import Look
+from agents.scripted.phases.grasp import Close
+from agents.scripted.phases.pull import start_pull
 from agents.scripted.rollout import run_episode
 from capt_common.typed_yaml import ConfigError, from_dict
 from capt_env.env_factory import make_env
 from capt_env.wrappers.estimate import JointAxisEstimate, unit
+
+
+def _cfg(**changes: object) -> ScriptedOpenerConfig:
+    """The default config with options changed, named by their dotted path with ``__`` for the dots."""
+    return with_options(ScriptedOpenerConfig(), **changes)
+
+
+def _pull_step(opener: ScriptedOpener, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
+               finger_gap: float | None = None, arm_qpos: np.ndarray | None = None) -> np.ndarray:
+    """One step of the opener's current phase (a pull) on these inputs, as ``act_on`` runs it but
+    without counting the step."""
+    opener.ctx.now = Look(est, p, r, finger_gap, arm_qpos)
+    action, following = opener.current.step(opener.ctx)
+    if following is not opener.current:
+        opener.enter(following)
+    return action
 
 
 def test_outward_normal_of_a_door_points_at_the_robot() -> None:
@@ -49,7 +71,7 @@ def test_a_closed_lid_is_gripped_from_above_across_its_lip() -> None:
     np.testing.assert_allclose(frame[:, 2], [0.0, 0.0, -1.0], atol=1e-9)  # approach: straight down
     assert abs(frame[:, 1] @ np.array([0.0, 1.0, 0.0])) == pytest.approx(1.0)  # fingers close along y
     # the TCP grips lid_edge_offset beyond the grasp point, away from the hinge (towards -x)
-    np.testing.assert_allclose(grasp_target(est, cfg), est.grasp_point + [-cfg.lid_edge_offset, 0, 0],
+    np.testing.assert_allclose(grasp_target(est, cfg), est.grasp_point + [-cfg.lid.edge_offset, 0, 0],
                                atol=1e-9)
 
 
@@ -59,28 +81,28 @@ def test_a_lip_the_fingers_closed_on_nothing_is_lifted_from_below() -> None:
     opener = ScriptedOpener(cfg)
     above = np.array([-0.1, 0.05, 0.05, 0.0, 1.0, 0.0, 0.0])  # TCP on the lip, pointing down (wxyz)
     opener.act_on(est, above)  # the first pre-grasp step sees a lid
-    opener._set(Phase.CLOSE, "reached")
-    for _ in range(cfg.close_steps):
+    opener.enter(Close("reached"))
+    for _ in range(cfg.grasp.close_steps):
         opener.act_on(est, above, finger_gap=0.0)
-    assert opener.phase == Phase.RELEASE and opener._lift  # backs off, then lifts from below
+    assert opener.phase == Phase.RELEASE and opener.ctx.lift  # backs off, then lifts from below
     # the lift goals: closed fingertips lid_lift_below under the lip, coming from the front (-x)
     # towards the hinge (+x), pointing lid_lift_pitch below horizontal, closing along the hinge
     pre, rot = lift_pose(est, np.eye(3), cfg, under=False)
     at, _ = lift_pose(est, np.eye(3), cfg, under=True)
-    np.testing.assert_allclose(pre, est.grasp_point + [-cfg.lid_lift_front, 0.0, -cfg.lid_lift_below],
+    np.testing.assert_allclose(pre, est.grasp_point + [-cfg.lid.lift.front, 0.0, -cfg.lid.lift.below],
                                atol=1e-9)
-    np.testing.assert_allclose(at, est.grasp_point + [cfg.lid_lift_under, 0.0, -cfg.lid_lift_below],
+    np.testing.assert_allclose(at, est.grasp_point + [cfg.lid.lift.under, 0.0, -cfg.lid.lift.below],
                                atol=1e-9)
-    pitch = cfg.lid_lift_pitch
+    pitch = cfg.lid.lift.pitch
     np.testing.assert_allclose(rot[:, 2], [np.cos(pitch), 0.0, -np.sin(pitch)], atol=1e-9)
     assert abs(rot[:, 1] @ np.array([0.0, 1.0, 0.0])) == pytest.approx(1.0)
     # fingers that closed on the lip (a gap) pull as before
     opener = ScriptedOpener(cfg)
     opener.act_on(est, above)
-    opener._set(Phase.CLOSE, "reached")
-    for _ in range(cfg.close_steps):
+    opener.enter(Close("reached"))
+    for _ in range(cfg.grasp.close_steps):
         opener.act_on(est, above, finger_gap=0.01)
-    assert opener.phase == Phase.PULL and not opener._lift
+    assert opener.phase == Phase.PULL and not opener.ctx.lift
 
 
 def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_hinge() -> None:
@@ -91,11 +113,11 @@ def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_
 
     def commanded(inward: float) -> np.ndarray:
         """The TCP translation (m) the opener commands from ``now``, lifting with ``inward``."""
-        opener = ScriptedOpener(ScriptedOpenerConfig(lid_lift_inward=inward, lid_lift_lead=0.12,
-                                                     max_step_m=1.0))
-        opener._lid = opener._lift = True
-        opener._start_pull(start, np.eye(3), est, "closed")
-        return opener._pull(est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
+        opener = ScriptedOpener(_cfg(lid__lift__inward=inward, lid__lift__lead=0.12,
+                                                     move__max_step_m=1.0))
+        opener.ctx.grasp.lid = opener.ctx.lift = True
+        opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))
+        return _pull_step(opener, est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
 
     plain, inward = commanded(0.0), commanded(0.02)
     goal = now + plain
@@ -112,10 +134,10 @@ def _lid_pull_after(seen_offset: np.ndarray, cfg: ScriptedOpenerConfig) -> Scrip
     start = est.grasp_point - np.array([0.0, 0.0, 0.01])
     now = est.pivot + axis_angle_matrix(est.direction, 0.5) @ (start - est.pivot)
     opener = ScriptedOpener(cfg)
-    opener._lid = opener._lift = True
-    opener._start_pull(start, np.eye(3), est, "closed")
+    opener.ctx.grasp.lid = opener.ctx.lift = True
+    opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))
     seen = JointAxisEstimate("revolute", est.direction, est.pivot, 0.5, now + seen_offset)
-    for _ in range(cfg.slip_steps + 2):
+    for _ in range(cfg.pull.slip_steps + 2):
         opener.act_on(seen, _pose(np.eye(3), now), finger_gap=0.0)
     return opener
 
@@ -125,7 +147,7 @@ def test_a_lid_grasp_point_sliding_along_the_hinge_is_not_a_slip() -> None:
     # point 11-13 cm along the hinge from the hand mid-pull, and the re-grasps ran out the episode
     along = np.array([0.0, 0.12, 0.0])
     assert _lid_pull_after(along, ScriptedOpenerConfig()).phase == Phase.PULL
-    off = _lid_pull_after(along, ScriptedOpenerConfig(lid_slip_off_axis=False))
+    off = _lid_pull_after(along, _cfg(lid__slip_off_axis=False))
     assert off.phase == Phase.PREGRASP and off.regrasps == 1
     # off the lid's arc (the lid fell back under the hand) is a slip either way
     below = _lid_pull_after(np.array([0.0, 0.0, -0.12]), ScriptedOpenerConfig())
@@ -140,12 +162,12 @@ def test_a_lid_lifted_from_below_leads_by_lid_lift_lead_and_a_gripped_one_by_rev
 
     def goal(lift: bool, lift_lead: float) -> np.ndarray:
         """Where the opener sends the TCP (m, world) from ``now``, in one uncapped step."""
-        cfg = ScriptedOpenerConfig(lid_lift_inward=0.0, lid_lift_lead=lift_lead, revolute_lead=0.12,
-                                   max_step_m=1.0)
+        cfg = _cfg(lid__lift__inward=0.0, lid__lift__lead=lift_lead, pull__revolute__lead=0.12,
+                                   move__max_step_m=1.0)
         opener = ScriptedOpener(cfg)
-        opener._lid, opener._lift = True, lift
-        opener._start_pull(start, np.eye(3), est, "closed")
-        return now + opener._pull(est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
+        opener.ctx.grasp.lid, opener.ctx.lift = True, lift
+        opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))
+        return now + _pull_step(opener, est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
 
     for lead in (0.12, 0.3):
         expected = est.pivot + axis_angle_matrix(hinge_y, 0.5 + lead) @ (start - est.pivot)
@@ -177,28 +199,29 @@ def test_fingers_that_closed_on_nothing_grasp_again_the_other_way_round() -> Non
     start = grasp_rotation(est, np.eye(3), cfg)
     at_handle = _pose(start, est.grasp_point)
     opener.act_on(est, at_handle)
-    assert opener._target_r is not None
-    np.testing.assert_allclose(opener._target_r, start, atol=1e-9)  # the nearer order: the one it has
-    opener._set(Phase.CLOSE, "reached")
-    for _ in range(cfg.close_steps):  # the arm stopped with a wrist joint at its limit
+    assert opener.ctx.grasp.target_r is not None
+    # the nearer order: the one it has
+    np.testing.assert_allclose(opener.ctx.grasp.target_r, start, atol=1e-9)
+    opener.enter(Close("reached"))
+    for _ in range(cfg.grasp.close_steps):  # the arm stopped with a wrist joint at its limit
         opener.act_on(est, at_handle, finger_gap=0.0, arm_qpos=WRIST_AT_LIMIT)
     assert opener.phase == Phase.RELEASE and opener.regrasps == 1
-    for _ in range(cfg.release_steps):
+    for _ in range(cfg.release.steps):
         opener.act_on(est, at_handle)
     assert opener.phase == Phase.RETREAT
-    backed_off = _pose(start, est.grasp_point - start[:, 2] * cfg.retreat_distance)
+    backed_off = _pose(start, est.grasp_point - start[:, 2] * cfg.release.retreat_distance)
     opener.act_on(est, backed_off)
     assert opener.phase == Phase.PREGRASP
     opener.act_on(est, backed_off)
     # same approach, fingers swapped: half a turn about the approach axis from where the hand is
-    np.testing.assert_allclose(opener._target_r[:, 2], start[:, 2], atol=1e-9)
-    np.testing.assert_allclose(opener._target_r[:, 1], -start[:, 1], atol=1e-9)
+    np.testing.assert_allclose(opener.ctx.grasp.target_r[:, 2], start[:, 2], atol=1e-9)
+    np.testing.assert_allclose(opener.ctx.grasp.target_r[:, 1], -start[:, 1], atol=1e-9)
     # fingers that closed on the handle (a gap) pull; with the option off, a miss pulls too
     for gap, other_fingers, phase in ((0.02, True, Phase.PULL), (0.0, False, Phase.PULL)):
-        opener = ScriptedOpener(ScriptedOpenerConfig(regrasp_other_fingers=other_fingers))
+        opener = ScriptedOpener(_cfg(recovery__other_fingers=other_fingers))
         opener.act_on(est, at_handle)
-        opener._set(Phase.CLOSE, "reached")
-        for _ in range(cfg.close_steps):
+        opener.enter(Close("reached"))
+        for _ in range(cfg.grasp.close_steps):
             opener.act_on(est, at_handle, finger_gap=gap)
         assert opener.phase == phase and opener.regrasps == 0
 
@@ -213,18 +236,18 @@ def _regrasp_after_a_miss(est: JointAxisEstimate, finger_gap: float, arm_qpos: n
     start = grasp_rotation(est, np.eye(3), cfg)
     at_handle = _pose(start, est.grasp_point)
     opener.act_on(est, at_handle)
-    opener._reach_why = approach_end
-    opener._set(Phase.CLOSE, approach_end)
-    for _ in range(cfg.close_steps):
+    opener.ctx.move.reach_why = approach_end
+    opener.enter(Close(approach_end))
+    for _ in range(cfg.grasp.close_steps):
         opener.act_on(est, at_handle, finger_gap=finger_gap, arm_qpos=arm_qpos)
     assert opener.phase == Phase.RELEASE and opener.regrasps == 1
-    for _ in range(cfg.release_steps):
+    for _ in range(cfg.release.steps):
         opener.act_on(est, at_handle)
-    backed_off = _pose(start, est.grasp_point - start[:, 2] * cfg.retreat_distance)
+    backed_off = _pose(start, est.grasp_point - start[:, 2] * cfg.release.retreat_distance)
     opener.act_on(est, backed_off)
     assert opener.phase == Phase.PREGRASP
     opener.act_on(est, backed_off)
-    return start, opener._target_r
+    return start, opener.ctx.grasp.target_r
 
 
 def _safe_door() -> JointAxisEstimate:
@@ -262,22 +285,22 @@ def test_a_sliding_panel_that_moves_sideways_is_gripped_square_on_and_pulled_sid
     est = _sliding([0.0, 1.0, 0.0])
     assert slides_across_face(est, cfg, ROBOT_SIDE)
     rot = grasp_rotation(est, np.eye(3), cfg, ROBOT_SIDE)
-    pitch = cfg.approach_pitch
+    pitch = cfg.approach.pitch
     # towards the face (+x) from the robot's side, pitched down; the fingers close along the slide
     np.testing.assert_allclose(rot[:, 2], [np.cos(pitch), 0.0, -np.sin(pitch)], atol=1e-9)
     assert abs(float(rot[:, 1] @ est.direction)) == pytest.approx(1.0)
     # the pull leads the handle along the slide, not towards the robot
-    opener = ScriptedOpener(ScriptedOpenerConfig(max_step_m=1.0))
-    opener._start_pull(est.grasp_point, rot, est, "closed")
-    move = opener._pull(est, est.grasp_point, rot, finger_gap=0.02)[:3] * ACTION_SCALE_M
-    np.testing.assert_allclose(move, [0.0, cfg.prismatic_lead, 0.0], atol=1e-9)
+    opener = ScriptedOpener(_cfg(move__max_step_m=1.0))
+    opener.enter(start_pull(opener.ctx, est.grasp_point, rot, est, "closed"))
+    move = _pull_step(opener, est, est.grasp_point, rot, finger_gap=0.02)[:3] * ACTION_SCALE_M
+    np.testing.assert_allclose(move, [0.0, cfg.pull.prismatic.lead, 0.0], atol=1e-9)
 
 
 def test_a_window_sliding_up_is_gripped_from_the_front_with_the_fingers_along_the_slide() -> None:
     cfg = ScriptedOpenerConfig()
     est = _sliding([0.0, 0.0, 1.0])
     rot = grasp_rotation(est, np.eye(3), cfg, ROBOT_SIDE)
-    pitch = cfg.approach_pitch
+    pitch = cfg.approach.pitch
     np.testing.assert_allclose(rot[:, 2], [np.cos(pitch), 0.0, -np.sin(pitch)], atol=1e-9)
     np.testing.assert_allclose(abs(rot[:, 1]), [np.sin(pitch), 0.0, np.cos(pitch)], atol=1e-9)
     # without the robot's side, or for a drawer sliding out towards the robot, along the axis as before
@@ -293,8 +316,8 @@ def test_a_window_lifted_open_is_held_there_not_let_go_to_fall_shut() -> None:
     for direction, kept in (([0.0, 0.0, 1.0], True), ([-1.0, 0.0, 0.0], False)):
         est = _sliding(direction)
         opener = ScriptedOpener(cfg)
-        opener._start_pull(est.grasp_point, np.eye(3), est, "closed")
-        top = est.grasp_point + np.array(direction) * (cfg.prismatic_target + 0.01)
+        opener.enter(start_pull(opener.ctx, est.grasp_point, np.eye(3), est, "closed"))
+        top = est.grasp_point + np.array(direction) * (cfg.pull.prismatic.target + 0.01)
         opener.act_on(est, _pose(np.eye(3), top), finger_gap=0.02)
         if not kept:  # a drawer pulled out is let go
             assert opener.phase == Phase.RELEASE
@@ -317,8 +340,8 @@ def _stalled_pull(arm_qpos: np.ndarray | None, cfg: ScriptedOpenerConfig) -> Scr
     opener = ScriptedOpener(cfg)
     at_handle = _pose(grasp_rotation(est, np.eye(3), cfg), est.grasp_point)
     opener.act_on(est, at_handle)
-    opener._start_pull(est.grasp_point, grasp_rotation(est, np.eye(3), cfg), est, "closed")
-    for _ in range(cfg.stall_steps + 2):
+    opener.enter(start_pull(opener.ctx, est.grasp_point, grasp_rotation(est, np.eye(3), cfg), est, "closed"))
+    for _ in range(cfg.pull.stall_steps + 2):
         opener.act_on(est, at_handle, finger_gap=0.02, arm_qpos=arm_qpos)
         if opener.phase != Phase.PULL:
             break
@@ -331,11 +354,11 @@ def test_a_pull_stalled_with_the_wrist_at_its_limit_grasps_again_the_other_way_r
     at_limit = free.copy()
     at_limit[4] = -2.89  # joint 5 within wrist_limit_margin of -2.8973 rad
     opener = _stalled_pull(at_limit, cfg)
-    assert opener.phase == Phase.RELEASE and opener.regrasps == 1 and opener._other_fingers
+    assert opener.phase == Phase.RELEASE and opener.regrasps == 1 and opener.ctx.grasp.other_fingers
     # a stall with the wrist free, with no joint angles, or with the option off grasps again as before
-    for qpos, config in ((free, cfg), (None, cfg), (at_limit, ScriptedOpenerConfig(wrist_limit_margin=0.0))):
+    for qpos, config in ((free, cfg), (None, cfg), (at_limit, _cfg(recovery__wrist_limit_margin=0.0))):
         opener = _stalled_pull(qpos, config)
-        assert opener.phase == Phase.RELEASE and opener.regrasps == 1 and not opener._other_fingers
+        assert opener.phase == Phase.RELEASE and opener.regrasps == 1 and not opener.ctx.grasp.other_fingers
 
 
 
@@ -370,13 +393,13 @@ def _pull_stalled_at(state: float, cfg: ScriptedOpenerConfig, perceived: float |
     rot = grasp_rotation(closed, np.eye(3), cfg)
     opener = ScriptedOpener(cfg)
     opener.act_on(closed, _pose(rot, closed.grasp_point))
-    opener._start_pull(closed.grasp_point, rot, closed, "closed")
+    opener.enter(start_pull(opener.ctx, closed.grasp_point, rot, closed, "closed"))
     est = _falling_oven(state if perceived is None else perceived)
     at = _pose(rot, _falling_oven(state).grasp_point)
-    for _ in range(cfg.stall_steps + 2):
+    for _ in range(cfg.pull.stall_steps + 2):
         opener.act_on(est, at, finger_gap=finger_gap)
     assert opener.phase == Phase.RELEASE
-    for _ in range(cfg.release_steps):
+    for _ in range(cfg.release.steps):
         opener.act_on(est, at)
     assert opener.phase == Phase.RETREAT
     return opener, at
@@ -393,54 +416,54 @@ def _hold_until_phase_changes(opener: ScriptedOpener, est: JointAxisEstimate, po
 
 def test_a_door_that_falls_open_past_fall_open_done_is_let_go_for_good() -> None:
     cfg = ScriptedOpenerConfig()
-    opener, at = _pull_stalled_at(cfg.fall_open_done + 0.1, cfg)
-    assert not opener._grasp_again and opener.regrasps == 0
-    est = _falling_oven(cfg.fall_open_done + 0.1)
+    opener, at = _pull_stalled_at(cfg.falling_door.done_above + 0.1, cfg)
+    assert not opener.ctx.grasp_again and opener.regrasps == 0
+    est = _falling_oven(cfg.falling_door.done_above + 0.1)
     waited = 0
-    while opener.phase == Phase.RETREAT and waited < cfg.move_timeout + cfg.settle_max_steps:
+    while opener.phase == Phase.RETREAT and waited < cfg.move.timeout_steps + cfg.falling_door.max_steps:
         opener.act_on(est, at)
-        waited += int(opener._settle is not None)
+        waited += int(opener.ctx.settle is not None)
     # it backed off, cleared the door's sweep and waited for it (still, here) before it was done
-    assert opener.phase == Phase.DONE and waited == cfg.settle_window + 1
+    assert opener.phase == Phase.DONE and waited == cfg.falling_door.window + 1
 
 
 def test_a_hand_that_ran_ahead_of_a_falling_door_does_not_end_the_opening() -> None:
     # fingers slipping along the handle carried the hand 1.6 rad round the arc, past fall_open_done
     # and revolute_stop_above, while the door (perceived) is 1.0 rad open: grasp again
     cfg = ScriptedOpenerConfig()
-    ahead = max(cfg.fall_open_done, cfg.revolute_stop_above) + 0.2
-    assert ahead < cfg.revolute_target
+    ahead = max(cfg.falling_door.done_above, cfg.pull.revolute.stop_above) + 0.2
+    assert ahead < cfg.pull.revolute.target
     opener, _ = _pull_stalled_at(ahead, cfg, perceived=1.0, finger_gap=0.02)
-    assert opener._grasp_again and opener.regrasps == 1
+    assert opener.ctx.grasp_again and opener.regrasps == 1
     # perceived past fall_open_done too: let go for good
-    opener, _ = _pull_stalled_at(ahead, cfg, perceived=cfg.fall_open_done + 0.1, finger_gap=0.02)
-    assert not opener._grasp_again and opener.regrasps == 0
+    opener, _ = _pull_stalled_at(ahead, cfg, perceived=cfg.falling_door.done_above + 0.1, finger_gap=0.02)
+    assert not opener.ctx.grasp_again and opener.regrasps == 0
 
 
 def test_a_door_let_go_short_of_open_is_cleared_and_waited_for_while_it_falls() -> None:
     cfg = ScriptedOpenerConfig()
     opener, at = _pull_stalled_at(1.0, cfg)
-    assert opener._grasp_again and opener.regrasps == 1
+    assert opener.ctx.grasp_again and opener.regrasps == 1
     est = _falling_oven(1.0)
-    for _ in range(cfg.move_timeout):  # the retreat ends (blocked: the hand is held still)
+    for _ in range(cfg.move.timeout_steps):  # the retreat ends (blocked: the hand is held still)
         opener.act_on(est, at)
-        if opener._settle is not None:
+        if opener.ctx.settle is not None:
             break
     # and the hand now waits, still in RETREAT, moving out of the door's sweep: radially away from
     # the hinge
-    assert opener.phase == Phase.RETREAT and opener._settle is not None
+    assert opener.phase == Phase.RETREAT and opener.ctx.settle is not None
     radial = at[:3] - est.pivot
     radial[1] = 0.0
     step = opener.act_on(est, at)[:3]
     assert step @ radial / (np.linalg.norm(step) * np.linalg.norm(radial)) == pytest.approx(1.0, abs=1e-6)
     # the door falls open by 0.02 rad a step: the hand keeps waiting past the settle window
-    for k in range(2 * cfg.settle_window):
+    for k in range(2 * cfg.falling_door.window):
         opener.act_on(_falling_oven(1.0 + 0.02 * k), at)
     assert opener.phase == Phase.RETREAT
     # it comes to rest past fall_open_done: done, no grasp again
-    rest = _falling_oven(cfg.fall_open_done + 0.2)
+    rest = _falling_oven(cfg.falling_door.done_above + 0.2)
     actions = _hold_until_phase_changes(opener, rest, at)
-    assert opener.phase == Phase.DONE and len(actions) == cfg.settle_window + 1
+    assert opener.phase == Phase.DONE and len(actions) == cfg.falling_door.window + 1
 
 
 def test_a_door_that_stays_where_it_was_let_go_is_grasped_again() -> None:
@@ -448,26 +471,28 @@ def test_a_door_that_stays_where_it_was_let_go_is_grasped_again() -> None:
     opener, at = _pull_stalled_at(1.0, cfg)
     est = _falling_oven(1.0)
     actions = _hold_until_phase_changes(opener, est, at)  # the retreat, then the wait
-    assert opener.phase == Phase.PREGRASP and len(actions) <= cfg.move_timeout + cfg.settle_window + 1
+    assert opener.phase == Phase.PREGRASP
+    assert len(actions) <= cfg.move.timeout_steps + cfg.falling_door.window + 1
     # fingers that then close on nothing back off and grasp again without another wait: only the
     # end of a pull lets the door go
-    opener._set(Phase.CLOSE, "reached")
-    for _ in range(cfg.close_steps + cfg.release_steps):
+    opener.enter(Close("reached"))
+    for _ in range(cfg.grasp.close_steps + cfg.release.steps):
         opener.act_on(est, at, finger_gap=0.0)
     assert opener.phase == Phase.RETREAT
-    for _ in range(cfg.move_timeout):
+    for _ in range(cfg.move.timeout_steps):
         opener.act_on(est, at)
-        assert opener._settle is None
+        assert opener.ctx.settle is None
         if opener.phase != Phase.RETREAT:
             break
     assert opener.phase == Phase.PREGRASP
     # let go short of settle_above (a door that falls slowly), or without the option, the hand grasps
     # again right after its retreat, without waiting
-    for state, config in ((cfg.settle_above - 0.1, cfg), (0.8, ScriptedOpenerConfig(fall_open_done=0.0))):
+    for state, config in ((cfg.falling_door.settle_above - 0.1, cfg),
+                          (0.8, _cfg(falling_door__done_above=0.0))):
         opener, at = _pull_stalled_at(state, config)
-        for _ in range(cfg.move_timeout):
+        for _ in range(cfg.move.timeout_steps):
             opener.act_on(_falling_oven(state), at)
-            assert opener._settle is None
+            assert opener.ctx.settle is None
             if opener.phase != Phase.RETREAT:
                 break
         assert opener.phase == Phase.PREGRASP
@@ -491,33 +516,33 @@ def test_a_door_seen_falling_open_before_its_grasp_is_waited_for_not_reached_for
     opener, seen = _reaching_for(falling, cfg)
     # waits (in RETREAT) from the first look at least settle_above open that has risen by
     # settle_progress since settle_window looks before (0.81 rad, the 16th)
-    assert cfg.settle_above == pytest.approx(0.8) and cfg.settle_window == 10
-    assert seen == 15 and opener.phase == Phase.RETREAT and opener._settle == [] and opener._grasp_again
-    assert opener._target_r is None and opener.regrasps == 0
+    assert cfg.falling_door.settle_above == pytest.approx(0.8) and cfg.falling_door.window == 10
+    assert seen == 15 and opener.phase == Phase.RETREAT and opener.ctx.settle == [] and opener.ctx.grasp_again
+    assert opener.ctx.grasp.target_r is None and opener.regrasps == 0
     hand = _pose(np.eye(3), np.array([-0.2, 0.0, 0.3]))
-    rest = _falling_oven(cfg.fall_open_done + 0.1)  # it came to rest fallen open: done
+    rest = _falling_oven(cfg.falling_door.done_above + 0.1)  # it came to rest fallen open: done
     actions = _hold_until_phase_changes(opener, rest, hand)
-    assert opener.phase == Phase.DONE and len(actions) == cfg.settle_window + 1
+    assert opener.phase == Phase.DONE and len(actions) == cfg.falling_door.window + 1
     # one that stops short of fall_open_done is grasped anew, the grasp orientation chosen again
     opener, _ = _reaching_for(falling, cfg)
     _hold_until_phase_changes(opener, _falling_oven(1.0), hand)
-    assert opener.phase == Phase.PREGRASP and opener._target_r is None and opener._settle is None
+    assert opener.phase == Phase.PREGRASP and opener.ctx.grasp.target_r is None and opener.ctx.settle is None
     # a door creeping open (pushed by the reaching hand), one still short of settle_above, the
     # option off, or a side door swinging: reached for as before (the still hand, blocked, goes on
     # to close its fingers)
     creeping = [0.8 + 0.004 * k for k in range(40)]
     short = [0.2 + 0.02 * k for k in range(25)]
     for states, config in ((creeping, cfg), (short, cfg),
-                           (falling, ScriptedOpenerConfig(watch_falling=False)),
-                           (falling, ScriptedOpenerConfig(fall_open_done=0.0))):
+                           (falling, _cfg(falling_door__watch=False)),
+                           (falling, _cfg(falling_door__done_above=0.0))):
         opener, seen = _reaching_for(states, config)
-        assert seen > cfg.settle_window and opener.phase != Phase.RETREAT and opener._settle is None
+        assert seen > cfg.falling_door.window and opener.phase != Phase.RETREAT and opener.ctx.settle is None
     side = ScriptedOpener(cfg)
     for k in range(40):
         est = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]),
                                 0.5 + 0.02 * k, np.array([-0.1, 0.2, 0.3]))
         side.act_on(est, _pose(np.eye(3), np.array([-0.3, 0.0, 0.3])))
-    assert side.phase != Phase.RETREAT and side._settle is None
+    assert side.phase != Phase.RETREAT and side.ctx.settle is None
 
 
 def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: float) -> ScriptedOpener:
@@ -529,11 +554,11 @@ def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: f
     rot = grasp_rotation(closed, np.eye(3), cfg)
     opener = ScriptedOpener(cfg)
     opener.act_on(closed, _pose(rot, closed.grasp_point))
-    opener._start_pull(closed.grasp_point, rot, closed, "closed")
+    opener.enter(start_pull(opener.ctx, closed.grasp_point, rot, closed, "closed"))
     turn = axis_angle_matrix(u, state)
     est = JointAxisEstimate("revolute", u, pivot, state, pivot + turn @ (closed.grasp_point - pivot))
     at = _pose(turn @ rot, est.grasp_point)
-    for _ in range(cfg.stall_steps + 2):
+    for _ in range(cfg.pull.stall_steps + 2):
         opener.act_on(est, at, finger_gap=finger_gap)
         if opener.phase != Phase.PULL:
             break
@@ -543,15 +568,15 @@ def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: f
 
 def test_a_side_door_held_far_open_that_stalls_is_at_its_stop() -> None:
     cfg = ScriptedOpenerConfig()
-    far = cfg.revolute_stop_above + 0.1  # short of revolute_target: a door whose limit comes first
-    assert far < cfg.revolute_target
+    far = cfg.pull.revolute.stop_above + 0.1  # short of revolute_target: a door whose limit comes first
+    assert far < cfg.pull.revolute.target
     opener = _side_door_stalled_at(far, cfg, finger_gap=0.02)
-    assert not opener._grasp_again and opener.regrasps == 0
+    assert not opener.ctx.grasp_again and opener.regrasps == 0
     # nearer closed, with the fingers closed on nothing, or with the option off: grasp again
-    for state, gap, config in ((cfg.revolute_stop_above - 0.3, 0.02, cfg), (far, 0.0, cfg),
-                               (far, 0.02, ScriptedOpenerConfig(revolute_stop_above=0.0))):
+    for state, gap, config in ((cfg.pull.revolute.stop_above - 0.3, 0.02, cfg), (far, 0.0, cfg),
+                               (far, 0.02, _cfg(pull__revolute__stop_above=0.0))):
         opener = _side_door_stalled_at(state, config, finger_gap=gap)
-        assert opener._grasp_again and opener.regrasps == 1, (state, gap)
+        assert opener.ctx.grasp_again and opener.regrasps == 1, (state, gap)
 
 
 def _drawer_slipped_at(stop_at: float, cfg: ScriptedOpenerConfig) -> ScriptedOpener:
@@ -561,7 +586,7 @@ def _drawer_slipped_at(stop_at: float, cfg: ScriptedOpenerConfig) -> ScriptedOpe
     rot = grasp_rotation(est, np.eye(3), cfg)
     opener = ScriptedOpener(cfg)
     opener.act_on(est, _pose(rot, est.grasp_point))
-    opener._start_pull(est.grasp_point, rot, est, "closed")
+    opener.enter(start_pull(opener.ctx, est.grasp_point, rot, est, "closed"))
     for k in range(1, 80):
         hand = 0.005 * k
         drawer = min(hand, stop_at)
@@ -576,14 +601,14 @@ def _drawer_slipped_at(stop_at: float, cfg: ScriptedOpenerConfig) -> ScriptedOpe
 
 def test_a_drawer_that_slips_out_far_open_is_at_its_stop() -> None:
     cfg = ScriptedOpenerConfig()
-    far = cfg.prismatic_stop_above + 0.1
+    far = cfg.pull.prismatic.stop_above + 0.1
     opener = _drawer_slipped_at(far, cfg)
-    assert opener.phase == Phase.RELEASE and not opener._grasp_again and opener.regrasps == 0
-    for _ in range(cfg.release_steps):
+    assert opener.phase == Phase.RELEASE and not opener.ctx.grasp_again and opener.regrasps == 0
+    for _ in range(cfg.release.steps):
         opener.act_on(_closed_drawer(), _pose(np.eye(3), np.zeros(3)))
     assert opener.phase == Phase.RETREAT
     # a slip near closed, or with the option off, grasps again
-    for stop_at, config in ((0.02, cfg), (far, ScriptedOpenerConfig(prismatic_stop_above=0.0))):
+    for stop_at, config in ((0.02, cfg), (far, _cfg(pull__prismatic__stop_above=0.0))):
         opener = _drawer_slipped_at(stop_at, config)
         assert opener.phase == Phase.PREGRASP and opener.regrasps == 1, stop_at
 
@@ -628,37 +653,43 @@ def test_the_holding_hand_measures_a_hinge_the_estimate_has_off() -> None:
     estimate = JointAxisEstimate("revolute", axis, hinge + [0.0, 0.04, 0.0], 0.0, grasp)
     def measured(cfg: ScriptedOpenerConfig) -> float:
         opener = ScriptedOpener(cfg)
-        opener._start_pull(grasp, np.eye(3), estimate, "closed")
+        opener.enter(start_pull(opener.ctx, grasp, np.eye(3), estimate, "closed"))
         for a in np.linspace(0.0, 0.9, 19)[1:]:
             p = hinge + axis_angle_matrix(axis, a) @ (grasp - hinge)
-            opener._pull(estimate, p, np.eye(3), finger_gap=0.02)
-        return opener._history[-1]
+            _pull_step(opener, estimate, p, np.eye(3), finger_gap=0.02)
+        return opener.ctx.pull.history[-1]
 
-    assert measured(ScriptedOpenerConfig(arc_fit=False)) > 1.05
+    assert measured(_cfg(pull__arc_fit__enabled=False)) > 1.05
     assert measured(ScriptedOpenerConfig()) == pytest.approx(0.9, abs=0.01)
 
 
 def test_bad_opener_config_is_rejected() -> None:
-    with pytest.raises(ConfigError, match="close_steps"):
-        from_dict(ScriptedOpenerConfig, {"close_steps": 0})
-    with pytest.raises(ConfigError, match="rotate_first_above"):
-        from_dict(ScriptedOpenerConfig, {"rotate_first_above": 0.0})
-    with pytest.raises(ConfigError, match="lid_lift_pitch"):
+    for data, name in (({"grasp": {"close_steps": 0}}, "grasp.close_steps"),
+                       ({"approach": {"rotate_first_above": 0.0}}, "approach.rotate_first_above"),
+                       ({"lid": {"lift": {"pitch": 2.0}}}, "lid.lift.pitch"),
+                       ({"lid": {"lift": {"below": -0.01}}}, "lid.lift.below"),
+                       ({"recovery": {"wrist_limit_margin": -0.1}}, "recovery.wrist_limit_margin"),
+                       ({"falling_door": {"done_above": -1.0}}, "falling_door.done_above"),
+                       ({"pull": {"revolute": {"stop_above": -0.5}}}, "pull.revolute.stop_above"),
+                       ({"pull": {"prismatic": {"stop_above": -0.1}}}, "pull.prismatic.stop_above"),
+                       ({"falling_door": {"window": 0}}, "falling_door.window"),
+                       ({"approach": {"rechoose_grasp_m": -0.01}}, "approach.rechoose_grasp_m")):
+        with pytest.raises(ConfigError, match=re.escape(name)):
+            from_dict(ScriptedOpenerConfig, data)
+
+
+def test_flat_keys_of_earlier_releases_load_onto_the_nested_options_with_a_warning() -> None:
+    with pytest.warns(FutureWarning, match=r"lid_lift_pitch -> lid\.lift\.pitch"):
+        cfg = from_dict(ScriptedOpenerConfig, {"lid_lift_pitch": 1.0, "approach_gap": 0.05,
+                                               "pull": {"stall_steps": 10}})
+    assert cfg.lid.lift.pitch == 1.0 and cfg.approach.gap == 0.05 and cfg.pull.stall_steps == 10
+    assert legacy_value(cfg, "lid_lift_pitch") == 1.0
+    assert from_dict(ScriptedOpenerConfig, {k: legacy_value(ScriptedOpenerConfig(), k)
+                                            for k in LEGACY_KEYS}) == ScriptedOpenerConfig()
+    with pytest.raises(ConfigError, match="both given"), pytest.warns(FutureWarning):
+        from_dict(ScriptedOpenerConfig, {"approach_gap": 0.05, "approach": {"gap": 0.05}})
+    with pytest.raises(ConfigError, match="lid.lift.pitch"), pytest.warns(FutureWarning):
         from_dict(ScriptedOpenerConfig, {"lid_lift_pitch": 2.0})
-    with pytest.raises(ConfigError, match="lid_lift_below"):
-        from_dict(ScriptedOpenerConfig, {"lid_lift_below": -0.01})
-    with pytest.raises(ConfigError, match="wrist_limit_margin"):
-        from_dict(ScriptedOpenerConfig, {"wrist_limit_margin": -0.1})
-    with pytest.raises(ConfigError, match="fall_open_done"):
-        from_dict(ScriptedOpenerConfig, {"fall_open_done": -1.0})
-    with pytest.raises(ConfigError, match="revolute_stop_above"):
-        from_dict(ScriptedOpenerConfig, {"revolute_stop_above": -0.5})
-    with pytest.raises(ConfigError, match="prismatic_stop_above"):
-        from_dict(ScriptedOpenerConfig, {"prismatic_stop_above": -0.1})
-    with pytest.raises(ConfigError, match="settle_window"):
-        from_dict(ScriptedOpenerConfig, {"settle_window": 0})
-    with pytest.raises(ConfigError, match="rechoose_grasp_m"):
-        from_dict(ScriptedOpenerConfig, {"rechoose_grasp_m": -0.01})
 
 
 def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
@@ -670,11 +701,11 @@ def test_the_hand_turns_in_place_before_it_travels_to_the_pregrasp() -> None:
     action = opener.act_on(drawer, down)
     assert np.all(action[:3] == 0.0) and np.abs(action[3:6]).max() > 0.5
     # once turned, it travels: the hand already at the grasp orientation moves towards the pregrasp
-    turned = Rotation.from_matrix(opener._target_r).as_quat(scalar_first=True)
+    turned = Rotation.from_matrix(opener.ctx.grasp.target_r).as_quat(scalar_first=True)
     action = opener.act_on(drawer, np.concatenate([down[:3], turned]))
     assert np.abs(action[:3]).max() > 0.1 and np.abs(action[3:6]).max() < 0.05
     # and not for ever: after rotate_first_steps steps it travels and turns together
-    opener = ScriptedOpener(ScriptedOpenerConfig(rotate_first_steps=0))
+    opener = ScriptedOpener(_cfg(approach__rotate_first_steps=0))
     assert np.abs(opener.act_on(drawer, down)[:3]).max() > 0.1
 
 
@@ -689,30 +720,30 @@ def test_the_grasp_orientation_is_chosen_again_for_a_grasp_point_seen_elsewhere(
     r = Rotation.from_quat(away[3:], scalar_first=True).as_matrix()
     for rechoose, expected in ((0.05, grasp_rotation(handle, r, ScriptedOpenerConfig())),
                                (0.0, grasp_rotation(first, r, ScriptedOpenerConfig()))):
-        opener = ScriptedOpener(ScriptedOpenerConfig(rechoose_grasp_m=rechoose, rechoose_looks=1))
+        opener = ScriptedOpener(_cfg(approach__rechoose_grasp_m=rechoose, approach__rechoose_looks=1))
         for _ in range(5):
             opener.act_on(first, away)
         assert opener.phase == Phase.PREGRASP and opener.phase_steps == 5
         opener.act_on(handle, away)
-        np.testing.assert_allclose(opener._target_r, expected, atol=1e-9)
+        np.testing.assert_allclose(opener.ctx.grasp.target_r, expected, atol=1e-9)
         assert opener.phase_steps == (1 if rechoose > 0 else 6)  # the move starts over
     # late in the pre-grasp move (an open part's grasp point jumps about) it is not chosen again
-    opener = ScriptedOpener(ScriptedOpenerConfig(rechoose_steps=5, rechoose_looks=1))
+    opener = ScriptedOpener(_cfg(approach__rechoose_steps=5, approach__rechoose_looks=1))
     for _ in range(5):
         opener.act_on(first, away)
     opener.act_on(handle, away)
-    np.testing.assert_allclose(opener._target_r, grasp_rotation(first, r, ScriptedOpenerConfig()),
+    np.testing.assert_allclose(opener.ctx.grasp.target_r, grasp_rotation(first, r, ScriptedOpenerConfig()),
                                atol=1e-9)
     assert not np.allclose(grasp_rotation(handle, r, ScriptedOpenerConfig()),
                            grasp_rotation(first, r, ScriptedOpenerConfig()), atol=0.1)
     # a grasp point that moved less than rechoose_grasp_m keeps the orientation and the move
     opener = ScriptedOpener(ScriptedOpenerConfig())
     opener.act_on(handle, away)
-    chosen = opener._target_r.copy()
+    chosen = opener.ctx.grasp.target_r.copy()
     nearby = JointAxisEstimate("revolute", handle.direction, handle.pivot, 0.0,
                                handle.grasp_point + [0.0, 0.03, 0.0])
     opener.act_on(nearby, away)
-    np.testing.assert_allclose(opener._target_r, chosen)
+    np.testing.assert_allclose(opener.ctx.grasp.target_r, chosen)
     assert opener.phase_steps == 2
 
 
@@ -729,21 +760,21 @@ def test_with_rechoose_looks_the_grasp_orientation_follows_only_a_grasp_point_se
     away = np.array([-0.2, 0.0, 0.4, 0.0, 1.0, 0.0, 0.0])  # TCP above the part, pointing down (wxyz)
     r = Rotation.from_quat(away[3:], scalar_first=True).as_matrix()
     cfg = ScriptedOpenerConfig()
-    assert cfg.rechoose_looks == 2
+    assert cfg.approach.rechoose_looks == 2
     chose_first = grasp_rotation(first, r, cfg)
     opener = ScriptedOpener(cfg)
     for est in (first, handle, first, handle, first):  # looks that keep jumping: kept
         for _ in range(2):
             opener.act_on(est, away)
-        np.testing.assert_allclose(opener._target_r, chose_first, atol=1e-9)
+        np.testing.assert_allclose(opener.ctx.grasp.target_r, chose_first, atol=1e-9)
     assert opener.phase_steps == 10
     opener.act_on(handle, away)  # one look at the handle: not yet
-    np.testing.assert_allclose(opener._target_r, chose_first, atol=1e-9)
+    np.testing.assert_allclose(opener.ctx.grasp.target_r, chose_first, atol=1e-9)
     opener.act_on(near_handle, away)  # the next look agrees (2 cm away): chosen again, move restarted
-    np.testing.assert_allclose(opener._target_r, grasp_rotation(near_handle, r, cfg), atol=1e-9)
+    np.testing.assert_allclose(opener.ctx.grasp.target_r, grasp_rotation(near_handle, r, cfg), atol=1e-9)
     assert opener.phase_steps == 1
     with pytest.raises(ConfigError, match="rechoose_looks"):
-        from_dict(ScriptedOpenerConfig, {"rechoose_looks": 0})
+        from_dict(ScriptedOpenerConfig, {"approach": {"rechoose_looks": 0}})
 
 
 def test_with_rechoose_part_kind_a_door_first_seen_as_a_lid_is_grasped_as_a_door() -> None:
@@ -757,21 +788,22 @@ def test_with_rechoose_part_kind_a_door_first_seen_as_a_lid_is_grasped_as_a_door
     door_again = JointAxisEstimate("revolute", unit(np.array([0.0, 0.01, 1.0])), door.pivot, 0.0, grasp_point)
     away = np.array([-0.2, 0.0, 0.4, 0.0, 1.0, 0.0, 0.0])
     r = Rotation.from_quat(away[3:], scalar_first=True).as_matrix()
-    assert ScriptedOpenerConfig().rechoose_part_kind is False  # not the default yet
+    assert ScriptedOpenerConfig().approach.rechoose_part_kind is False  # not the default yet
     for on in (True, False):
-        cfg = ScriptedOpenerConfig(rechoose_part_kind=on)
+        cfg = _cfg(approach__rechoose_part_kind=on)
         kinds = [part_kind(e, cfg) for e in (lid, door, door_again)]
         assert kinds == ["lid", "vertical_hinge", "vertical_hinge"]
         opener = ScriptedOpener(cfg)
         opener.act_on(lid, away)
-        assert opener._lid
+        assert opener.ctx.grasp.lid
         opener.act_on(door, away)  # one look at a side door: not yet
-        assert opener._lid and opener.phase_steps == 2
+        assert opener.ctx.grasp.lid and opener.phase_steps == 2
         opener.act_on(door_again, away)  # the next look agrees
-        assert opener._lid is not on
+        assert opener.ctx.grasp.lid is not on
         if on:
             assert opener.phase_steps == 1
-            np.testing.assert_allclose(opener._target_r, grasp_rotation(door_again, r, cfg), atol=1e-9)
+            again = grasp_rotation(door_again, r, cfg)
+            np.testing.assert_allclose(opener.ctx.grasp.target_r, again, atol=1e-9)
     assert part_kind(_closed_drawer(), cfg) == "prismatic" and part_kind(_oven(), cfg) == "hinge"
 
 
@@ -786,18 +818,18 @@ def test_the_finger_order_the_wrist_cannot_reach_is_rehearsed_and_not_taken() ->
     lift = JointAxisEstimate("prismatic", np.array([0.0, 0.0, 1.0]), tcp[:3, 3] - [0, 0, 0.15], 0.0,
                              tcp[:3, 3] - [0, 0, 0.15])
     pose = np.concatenate([tcp[:3, 3], Rotation.from_matrix(tcp[:3, :3]).as_quat(scalar_first=True)])
-    plain = ScriptedOpener(ScriptedOpenerConfig(rehearse_fingers=False, prismatic_target=0.1, **along))
+    plain = ScriptedOpener(_cfg(grasp__rehearse_fingers=False, pull__prismatic__target=0.1, **along))
     plain.act_on(lift, pose, finger_gap=0.06, arm_qpos=q)
-    assert plain._target_r[:, 0] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(-1.0, abs=1e-6)
-    rehearsed = ScriptedOpener(ScriptedOpenerConfig(prismatic_target=0.1, **along))
+    assert plain.ctx.grasp.target_r[:, 0] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(-1.0, abs=1e-6)
+    rehearsed = ScriptedOpener(_cfg(pull__prismatic__target=0.1, **along))
     rehearsed.act_on(lift, pose, finger_gap=0.06, arm_qpos=q)
     nearer, other = rehearsed.rehearsals
     assert nearer.grasp_error_rad > 2 * 0.12 and other.pull_share == 1.0
-    assert rehearsed._target_r[:, 0] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(1.0, abs=1e-6)
+    assert rehearsed.ctx.grasp.target_r[:, 0] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(1.0, abs=1e-6)
     # without the arm's joint angles there is nothing to rehearse: the nearer order
-    blind = ScriptedOpener(ScriptedOpenerConfig(prismatic_target=0.1, **along))
+    blind = ScriptedOpener(_cfg(pull__prismatic__target=0.1, **along))
     blind.act_on(lift, pose)
-    assert blind.rehearsals is None and np.allclose(blind._target_r, plain._target_r)
+    assert blind.rehearsals is None and np.allclose(blind.ctx.grasp.target_r, plain.ctx.grasp.target_r)
 
 
 @pytest.mark.parametrize(("category", "seed", "max_steps"), [

@@ -63,14 +63,14 @@ def test_rollout_opener_overrides_load_and_name_a_bad_key(tmp_path: Path) -> Non
     repo = Path(__file__).resolve().parents[2]
     for path in sorted((repo / "configs" / "opener").glob("*.yaml")):
         assert opener_config(str(path)) != opener_config(None)  # each changes something
-    assert opener_config(str(repo / "configs/opener/steep_door_approach.yaml")).vertical_hinge_pitch == 1.0
-    assert opener_config(str(repo / "configs/opener/rechoose_every_look.yaml")).rechoose_looks == 1
+    assert opener_config(str(repo / "configs/opener/steep_door_approach.yaml")).side_door.pitch == 1.0
+    assert opener_config(str(repo / "configs/opener/rechoose_every_look.yaml")).approach.rechoose_looks == 1
     bad = tmp_path / "bad.yaml"
     bad.write_text("vertical_hinge_pich: 1.0\n")
     with pytest.raises(SystemExit, match="vertical_hinge_pich"):
         opener_config(str(bad))
-    bad.write_text("approach_gap: 0.2\n")
-    with pytest.raises(SystemExit, match="approach_gap"):
+    bad.write_text("approach:\n  gap: 0.2\n")
+    with pytest.raises(SystemExit, match="approach.gap"):
         opener_config(str(bad))
     assert main(["rollout", "--policy", "ppo", "--opener", str(bad), "--episodes", "1"]) == 2
 
@@ -82,7 +82,7 @@ def test_rollout_records_the_opener_it_ran(tmp_path: Path) -> None:
                  "--opener", str(repo / "configs/opener/steep_door_approach.yaml"),
                  "--json", str(out)]) == 0
     data = json.loads(out.read_text())
-    assert data["opener"]["vertical_hinge_pitch"] == 1.0 and data["opener"]["approach_pitch"] == 0.55
+    assert data["opener"]["side_door"]["pitch"] == 1.0 and data["opener"]["approach"]["pitch"] == 0.55
     assert data["results"][0]["episodes"][0]["steps"] == 3
 
 

@@ -1,0 +1,285 @@
+"""The pull: the held part is moved along its estimated arc (revolute) or line (prismatic), its state
+measured by the hand's own travel every step (free of the perceived state's noise), the axis corrected
+by the holding hand's path (``pull.arc_fit``) or the part's (``pull.motion_axis``). It ends at the
+target, on a stall, at a prismatic part's end stop, or when the hand slips off."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from agents.scripted.geometry import axis_angle_matrix, fit_circle, off_axis, swept_angle
+from agents.scripted.grasp_pose import falls_open, is_vertical_hinge
+from agents.scripted.motion_axis import fit_motion_axis
+from agents.scripted.phases import reach, release
+from agents.scripted.phases.base import (
+    GRIPPER_CLOSE,
+    GRIPPER_OPEN,
+    OpenerPhase,
+    Phase,
+    goto,
+    hold,
+    wrist_at_limit,
+)
+from agents.scripted.phases.context import OpenerContext
+from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, unit
+
+
+def start_pull(ctx: OpenerContext, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate, why: str) -> Pull:
+    """Begin a pull from the TCP pose ``p`` (3,), ``r`` (3, 3) on ``est``: the phase to enter."""
+    track = ctx.pull
+    track.grasp_p, track.grasp_r, track.grasp_state = p.copy(), r.copy(), est.state
+    track.grasp_u = unit(est.direction)
+    track.falls = falls_open(est, ctx.cfg)
+    track.history = []
+    track.pulled = [p.copy()]
+    track.held = [p.copy()]
+    track.hinge_fit = None
+    track.slip_count = 0
+    # a hand lifting from below holds with closed fingers; unknown gaps count as holding
+    return Pull(why, grip="held" if ctx.lift else "none")
+
+
+class Pull(OpenerPhase):
+    """Pull the part towards ``state now + lead`` every step; see the module docstring."""
+
+    phase = Phase.PULL
+
+    def step(self, ctx: OpenerContext) -> tuple[np.ndarray, OpenerPhase]:
+        cfg, look, track = ctx.cfg, ctx.now, ctx.pull
+        assert look is not None and track.grasp_p is not None and track.grasp_r is not None
+        est, p, r, finger_gap, arm_qpos = look.est, look.p, look.r, look.finger_gap, look.arm_qpos
+        lid = ctx.grasp.lid
+        revolute = est.joint_type == "revolute"
+        u = unit(est.direction)
+        if track.grasp_u is not None and float(u @ track.grasp_u) < 0.0:
+            # the part opens the way it did when the pull began: a re-estimate that flips the axis
+            # (the sign is what a single view gets wrong most) would read the opening as closing
+            u = -u
+        if cfg.pull.motion_axis.enabled:
+            u = motion_axis(ctx, est, u, p, r, finger_gap, revolute)
+        # while the hand holds the part, its own travel along the estimated arc or line measures the
+        # part's state every step; the perceived state is noisier and only as fresh as the last estimate
+        if ctx.axis.motion is not None:
+            pivot = ctx.axis.motion.pivot
+        else:
+            pivot = hinge_pivot(ctx, u, est.pivot, p, finger_gap) if revolute else est.pivot
+        state = hand_state(ctx, u, pivot, p, revolute)
+        track.history.append(state)
+        track.pulled.append(p.copy())
+        # a drawer runs freely up to its end stop, where the hand brakes before the handle slides out
+        # of the fingers: that is the limit, and grasping again would chase a part that is open
+        at_limit = not revolute and braked(ctx)
+        if revolute:
+            target = cfg.lid.target if lid else cfg.pull.revolute.target
+        else:
+            target = cfg.pull.prismatic.target
+        min_progress = cfg.pull.revolute.stall_progress if revolute else cfg.pull.prismatic.stall_progress
+        # progress over the last stall_steps, measured about the pivot in use now (arc_fit may
+        # have moved it, which changes the state read along the whole path, not the part's motion)
+        stalled = False
+        if len(track.pulled) > cfg.pull.stall_steps + 1:
+            before = track.pulled[-1 - cfg.pull.stall_steps]
+            progress = (swept_angle(u, pivot, before, p) if revolute else float((p - before) @ u))
+            stalled = progress < min_progress
+        holding = finger_gap is not None and finger_gap >= cfg.grasp.hold_gap
+        record_grip(ctx, holding, finger_gap is None)
+        falls = release.lets_fall(ctx)
+        fall = cfg.falling_door
+        if state >= target or stalled or at_limit:
+            why = "target" if state >= target else "stall" if stalled else "limit"
+            # short of the target the grip slipped or the arm ran out of range: grasp again from here
+            ctx.grasp_again = state < target and not at_limit and ctx.regrasps < cfg.recovery.max_regrasps
+            wrist_stuck = stalled and wrist_at_limit(arm_qpos, cfg.recovery.wrist_limit_margin)
+            if falls and min(state, float(est.state)) >= fall.done_above:
+                # a door that falls open, past done_above: grasping it again pushes it back. Both the
+                # hand and the perception must say so: fingers slipping along the handle carry the
+                # hand round the arc ahead of the door
+                ctx.grasp_again = False
+            if (stalled and revolute and not lid and not falls and holding and not wrist_stuck
+                    and 0.0 < cfg.pull.revolute.stop_above <= state):
+                # held far open and the arm still in range: the part is at its end stop, and reaching
+                # for the handle again would knock it back
+                ctx.grasp_again = False
+            ctx.regrasps += int(ctx.grasp_again)
+            ctx.let_go_state = state
+            if not ctx.grasp_again and holding and falls_back(ctx, u, revolute):
+                # let go, a part lifted against gravity slides back closed: hold it where it is
+                ctx.hold_at = (p.copy(), r.copy())
+                return hold(GRIPPER_CLOSE), release.Done(why)
+            if ctx.grasp_again and wrist_stuck:
+                # the arm ran out of range with this finger order: the other one turns the wrist the
+                # other way
+                ctx.grasp.other_fingers = True
+            return hold(GRIPPER_CLOSE), release.Release(why)
+        away = p - np.asarray(est.grasp_point, dtype=np.float64)
+        if lid and cfg.lid.slip_off_axis:  # a lid is revolute (part_kind)
+            away = off_axis(away, u)  # along its hinge, a lid's far edge is all the same to the hand
+        far = float(np.linalg.norm(away)) > cfg.pull.slip_distance and not holding
+        track.slip_count = track.slip_count + 1 if far else 0
+        slipped = track.slip_count >= cfg.pull.slip_steps
+        if slipped and ctx.phase_log[-1].get("grip") == "held":
+            ctx.phase_log[-1]["grip"] = "lost"  # (a lift's closed fingers tell no gap)
+        if slipped and falls and est.state >= fall.settle_above:
+            # off the handle of a door that falls open: let go, clear it and wait instead of reaching
+            # for a handle on the move; past done_above it is left open
+            ctx.grasp_again = est.state < fall.done_above and ctx.regrasps < cfg.recovery.max_regrasps
+            ctx.regrasps += int(ctx.grasp_again)
+            ctx.let_go_state = float(est.state)
+            return hold(GRIPPER_OPEN), release.Release("slip")
+        if slipped and not revolute and 0.0 < cfg.pull.prismatic.stop_above <= state:
+            # off the handle of a drawer pulled far out: it ran to its end stop and the brake was
+            # missed; reaching for the handle again would push the open drawer back in
+            ctx.grasp_again = False
+            ctx.let_go_state = state
+            return hold(GRIPPER_OPEN), release.Release("slip")
+        if slipped and ctx.regrasps < cfg.recovery.max_regrasps:
+            ctx.regrasps += 1
+            ctx.grasp.target_r = None
+            return hold(GRIPPER_OPEN), reach.pregrasp(ctx, "slip")
+        p_des, r_des = pull_pose(ctx, est, u, pivot, state, revolute)
+        action, _, _ = goto(ctx, p, r, p_des, r_des, GRIPPER_CLOSE)
+        return action, self
+
+
+def pull_pose(ctx: OpenerContext, est: JointAxisEstimate, u: np.ndarray, pivot: np.ndarray, state: float,
+              revolute: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The TCP goal (position (3,), rotation (3, 3)) of a pull step: the grasp pose moved with the part
+    to ``state + lead``, rotated about unit axis ``u`` through ``pivot`` or shifted along ``u``."""
+    cfg, track, lid = ctx.cfg, ctx.pull, ctx.grasp.lid
+    assert track.grasp_p is not None and track.grasp_r is not None
+    if not revolute:
+        delta = state - track.grasp_state + cfg.pull.prismatic.lead
+        return track.grasp_p + u * delta, track.grasp_r
+    lifting = lid and ctx.lift
+    lift = cfg.lid.lift
+    delta = state - track.grasp_state + (lift.lead if lifting else cfg.pull.revolute.lead)
+    p_des = pivot + axis_angle_matrix(u, delta) @ (track.grasp_p - pivot)
+    if lifting and lift.inward > 0.0:
+        # lifting from below, the fingertips slide towards the hinge as the lid turns: off the lid's
+        # own arc (an estimated hinge a centimetre or two off), they stay under it
+        radial = off_axis(p_des - pivot, u)
+        radius = float(np.linalg.norm(radial))
+        if radius > 1e-6:
+            p_des = p_des - min(lift.inward * max(delta, 0.0), 0.5 * radius) * radial / radius
+    if is_vertical_hinge(est, cfg):
+        follow = 1.0
+    elif lid:
+        follow = lift.wrist_follow if ctx.lift else cfg.lid.wrist_follow
+    else:
+        follow = cfg.pull.revolute.wrist_follow
+    return p_des, axis_angle_matrix(u, follow * delta) @ track.grasp_r
+
+
+def record_grip(ctx: OpenerContext, holding: bool, unknown: bool) -> None:
+    """Record in this pull's ``phase_log`` entry whether the fingers hold the part: its ``"grip"`` is
+    ``"none"`` until the finger gap first reads at least ``grasp.hold_gap`` (``holding``), then
+    ``"held"``, and ``"lost"`` once the fingers have closed on nothing after holding (or the slip check
+    fires on a hand lifting from below, whose closed fingers tell no gap). Without a gap (``unknown``)
+    a pull counts as held."""
+    entry = ctx.phase_log[-1]
+    if unknown:
+        if entry.get("grip") == "none":
+            entry["grip"] = "held"
+    elif holding:
+        entry["grip"] = "held"
+    elif entry.get("grip") == "held" and not ctx.lift:
+        entry["grip"] = "lost"
+
+
+def falls_back(ctx: OpenerContext, u: np.ndarray, revolute: bool) -> bool:
+    """Whether a prismatic part opening along unit ``u`` (3,) rises more than
+    ``sliding_panel.hold_rising_above`` above horizontal, so that gravity slides it back closed once
+    let go (a window sliding up; 0: never)."""
+    rise = ctx.cfg.sliding_panel.hold_rising_above
+    return not revolute and rise > 0.0 and float(u[2]) > float(np.sin(rise))
+
+
+def braked(ctx: OpenerContext) -> bool:
+    """Whether the hand, pulling at a cruising speed (median step of this pull, at least
+    ``limit_min_speed_m``), moved less than ``limit_slowdown`` of it in each of the last
+    ``limit_window`` steps under the same command (``pull.prismatic``): something stopped the part."""
+    cfg = ctx.cfg.pull.prismatic
+    steps = np.diff(ctx.pull.history)
+    if len(steps) < cfg.limit_window + 5:
+        return False
+    cruise = float(np.median(steps[:-cfg.limit_window]))
+    recent = steps[-cfg.limit_window:]
+    return cruise >= cfg.limit_min_speed_m and bool(np.all(recent < cfg.limit_slowdown * cruise))
+
+
+def hand_state(ctx: OpenerContext, u: np.ndarray, pivot: np.ndarray, p: np.ndarray, revolute: bool) -> float:
+    """The part's state (rad or m) by the hand's own measure: the state at the grasp plus the TCP's
+    travel from the grasp position to ``p`` about (revolute) or along unit axis ``u``."""
+    track = ctx.pull
+    assert track.grasp_p is not None
+    if revolute:
+        return track.grasp_state + swept_angle(u, pivot, track.grasp_p, p)
+    return track.grasp_state + float((p - track.grasp_p) @ u)
+
+
+def hinge_pivot(ctx: OpenerContext, u: np.ndarray, pivot: np.ndarray, p: np.ndarray,
+                finger_gap: float | None) -> np.ndarray:
+    """The pivot (3,) to pull about: the centre of the circle the holding hand's path follows about
+    unit axis ``u`` when ``pull.arc_fit`` accepts it, else the estimated ``pivot``. ``p``: the TCP
+    position now, added to the path while the fingers hold."""
+    cfg, track = ctx.cfg.pull.arc_fit, ctx.pull
+    if not cfg.enabled or finger_gap is None or finger_gap < ctx.cfg.grasp.hold_gap:
+        return pivot
+    if track.hinge_fit is not None:
+        return track.hinge_fit
+    track.held.append(p.copy())
+    path = np.asarray(track.held)
+    if (np.linalg.norm(path - path[0], axis=1).max() < cfg.min_chord
+            or abs(swept_angle(u, pivot, path[0], p)) < cfg.min_angle):
+        return pivot
+    fit = fit_circle(path, u)
+    if fit is None or fit[2] > cfg.max_rms:
+        return pivot
+    offset = fit[0] - pivot
+    if np.linalg.norm(off_axis(offset, u)) > cfg.max_shift:
+        return pivot
+    # kept for the rest of the pull: a hand that later slips off the handle leaves the arc
+    track.hinge_fit = fit[0]
+    return fit[0]
+
+
+def motion_axis(ctx: OpenerContext, est: JointAxisEstimate, u: np.ndarray, p: np.ndarray, r: np.ndarray,
+                finger_gap: float | None, revolute: bool) -> np.ndarray:
+    """The axis direction to pull along (``pull.motion_axis``): the one fitted to the path of the
+    estimated grasp point while held (:func:`~agents.scripted.motion_axis.fit_motion_axis`), once it
+    fits, else ``u``. The first accepted fit is kept for the episode (later pulls too) and starts this
+    pull over from where the hand is, so the arc or line it follows does not jump."""
+    cfg, track, axis = ctx.cfg.pull.motion_axis, ctx.pull, ctx.axis
+    holding = finger_gap is not None and finger_gap >= ctx.cfg.grasp.hold_gap
+    gp = np.asarray(est.grasp_point, dtype=np.float64)
+    if holding and (not axis.part_path or np.linalg.norm(gp - axis.part_path[-1]) > 1e-3):
+        axis.part_path.append(gp.copy())  # a new estimate (they repeat between looks)
+    if axis.motion is None and holding:
+        pivot = track.hinge_fit if track.hinge_fit is not None else est.pivot
+        fit = fit_motion_axis(np.asarray(axis.part_path), u, pivot, revolute, cfg.min_travel, cfg.min_angle,
+                              cfg.max_rms, cfg.max_turn, cfg.max_ratio, cfg.hinge_points if revolute else 3)
+        if fit is not None:
+            track.grasp_state = hand_state(ctx, u, pivot, p, revolute)
+            track.grasp_p, track.grasp_r, track.grasp_u = p.copy(), r.copy(), fit.direction
+            track.pulled, track.held, track.hinge_fit = [p.copy()], [p.copy()], None
+            axis.motion, axis.motion_type = fit, est.joint_type
+    if axis.motion is None:
+        return u
+    direction = axis.motion.direction
+    return direction if float(direction @ u) >= 0.0 else -direction
+
+
+def with_motion_axis(ctx: OpenerContext, est: JointAxisEstimate) -> JointAxisEstimate:
+    """``est`` with the axis fitted to the part's motion (signed like ``est``'s direction; a revolute
+    pivot moved to the point of the fitted line closest to the grasp point)."""
+    assert ctx.axis.motion is not None
+    direction = ctx.axis.motion.direction
+    if float(direction @ est.direction) < 0.0:
+        direction = -direction
+    pivot = est.pivot
+    if est.joint_type == "revolute":
+        grasp = np.asarray(est.grasp_point, dtype=np.float64)
+        pivot = canonical_pivot(direction, ctx.axis.motion.pivot, grasp)
+    return replace(est, direction=direction, pivot=pivot)

@@ -1,0 +1,294 @@
+"""Reaching the grasp: the pre-grasp (turn the hand to the grasp orientation, move outside the grasp
+point), the approach (in along the approach axis), and the same two moves of the lift from below (a
+lid whose lip is wider than the open fingers: the closed fingertips line up in front of the lip, then
+slide in under it). The grasp orientation is chosen as a grasp's pre-grasp starts, and again early in
+it when the perceived grasp point or part kind changes (``approach.rechoose_*``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from agents.scripted.geometry import axis_angle_matrix
+from agents.scripted.grasp_pose import (
+    SWAP_FINGERS,
+    falls_open,
+    grasp_rotation,
+    grasp_target,
+    is_lid,
+    is_vertical_hinge,
+    lift_pose,
+    part_kind,
+    quarter_turn,
+)
+from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
+from agents.scripted.panda_kinematics import base_in_world, pose_matrix
+from agents.scripted.phases import grasp, pull, release
+from agents.scripted.phases.base import (
+    GRIPPER_CLOSE,
+    GRIPPER_OPEN,
+    OpenerPhase,
+    Phase,
+    goto,
+    gripper_action,
+    hold,
+    reached,
+)
+from agents.scripted.phases.context import OpenerContext
+from capt_env.wrappers.estimate import JointAxisEstimate, unit
+
+
+def pregrasp(ctx: OpenerContext, why: str) -> OpenerPhase:
+    """The pre-grasp of a new grasp: :class:`LiftLineUp` once a lid is lifted from below, else
+    :class:`PreGrasp`."""
+    return LiftLineUp(why) if ctx.lift else PreGrasp(why)
+
+
+class _Reach(OpenerPhase):
+    """A move to a pose by the grasp point (see :class:`PreGrasp`, :class:`Approach`)."""
+
+    def step(self, ctx: OpenerContext) -> tuple[np.ndarray, OpenerPhase]:
+        cfg, look, choice = ctx.cfg, ctx.now, ctx.grasp
+        assert look is not None
+        est, p, r = look.est, look.p, look.r
+        if falling_on_its_own(ctx, est):
+            # the door is falling open ahead of the hand (brushed by it while turning, or let go
+            # short of open): reaching for its handle would push it back, so clear its sweep and
+            # wait; if it stops short of falling_door.done_above it is grasped anew
+            ctx.pull.grasp_p = np.array(est.grasp_point, dtype=np.float64)
+            ctx.grasp_again, choice.target_r = True, None
+            ctx.retreat_from, ctx.settle = p.copy(), []
+            return hold(GRIPPER_OPEN), release.WaitForFall("falling_open")
+        if self.phase == Phase.PREGRASP:
+            choice.pregrasp_steps += 1
+            if choice.pregrasp_steps <= cfg.approach.rechoose_steps and (
+                    grasp_point_moved(ctx, est) or part_kind_changed(ctx, est)):
+                # a different grasp point or part kind: choose again and start the move over (early in
+                # the move only: a part seen open jumps about from look to look, and each start over
+                # turns the hand first)
+                ctx.phase_steps = 1
+        if choice.target_r is None or self.phase == Phase.PREGRASP and ctx.phase_steps == 1:
+            choose_grasp(ctx, est, p, r, look.arm_qpos)
+        assert choice.target_r is not None
+        goal, gripper = self.goal(ctx, est)
+        action, perr, rerr = goto(ctx, p, r, goal, choice.target_r, gripper)
+        if (self.phase == Phase.PREGRASP and rerr > cfg.approach.rotate_first_above
+                and ctx.phase_steps <= cfg.approach.rotate_first_steps):
+            # turn the hand where it is first: turned while travelling, the IK ends low and far
+            # with the wrist at its limit, from where it cannot hold the grasp pose
+            action[:3] = 0.0
+            return action, self
+        if reached(ctx, p, perr, rerr):
+            return action, self.next(ctx, est)
+        return action, self
+
+    def goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float]:
+        """TCP goal position (3,) and gripper action; may also set ``ctx.grasp.target_r``."""
+        raise NotImplementedError
+
+    def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
+        """The phase after the move ended (``ctx.move.reach_why`` says how)."""
+        raise NotImplementedError
+
+
+class PreGrasp(_Reach):
+    """Open the gripper to the approach gap, turn the hand in place to the grasp orientation and move to
+    ``approach.pregrasp_offset`` outside the grasp point along the approach axis."""
+
+    phase = Phase.PREGRASP
+
+    def goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float]:
+        cfg, choice = ctx.cfg, ctx.grasp
+        assert choice.target_r is not None
+        approach = choice.target_r[:, 2]
+        point = grasp_target(est, cfg) if choice.lid else est.grasp_point
+        return (point - approach * cfg.approach.pregrasp_offset,
+                gripper_action(cfg.lid.gap if choice.lid else cfg.approach.gap))
+
+    def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
+        return LiftSlideUnder(ctx.move.reach_why) if ctx.lift else Approach(ctx.move.reach_why)
+
+
+class Approach(_Reach):
+    """Advance ``approach.grasp_depth`` past the grasp point; then close."""
+
+    phase = Phase.APPROACH
+
+    def goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float]:
+        cfg, choice = ctx.cfg, ctx.grasp
+        assert choice.target_r is not None
+        approach = choice.target_r[:, 2]
+        point = grasp_target(est, cfg) if choice.lid else est.grasp_point
+        return (point + approach * cfg.approach.grasp_depth,
+                gripper_action(cfg.lid.gap if choice.lid else cfg.approach.gap))
+
+    def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
+        return grasp.Close(ctx.move.reach_why)
+
+
+class _Lift:
+    """The lift from below's goal: the closed fingertips, pointing at the hinge and steeply down
+    (:func:`~agents.scripted.grasp_pose.lift_pose`); the plain grasp's goal when the grasp point lies
+    on the hinge line."""
+
+    under = False
+
+    def lift_goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float] | None:
+        assert ctx.now is not None
+        lift = lift_pose(est, ctx.now.r, ctx.cfg, under=self.under)
+        if lift is None:
+            return None
+        goal, ctx.grasp.target_r = lift
+        return goal, GRIPPER_CLOSE
+
+
+class LiftLineUp(_Lift, PreGrasp):
+    """Lift from below, first move: the closed fingertips line up ``lid.lift.front`` in front of the lip."""
+
+    def goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float]:
+        return self.lift_goal(ctx, est) or super().goal(ctx, est)
+
+
+class LiftSlideUnder(_Lift, Approach):
+    """Lift from below, second move: the fingertips slide in under the lip; then push it open (a pull)."""
+
+    under = True
+
+    def goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float]:
+        self._lifting = self.lift_goal(ctx, est)
+        return self._lifting or super().goal(ctx, est)
+
+    def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
+        if self._lifting is not None:  # the closed fingertips are under the lid: push it open
+            assert ctx.now is not None
+            return pull.start_pull(ctx, ctx.now.p, ctx.now.r, est, "under")
+        return super().next(ctx, est)
+
+
+def choose_grasp(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
+                 arm_qpos: np.ndarray | None) -> None:
+    """Choose the grasp's TCP rotation for ``est`` (a new grasp when none is chosen): across the
+    handle, the finger order nearer the hand's rotation unless the rehearsal prefers the other, turned
+    a quarter or half turn as recoveries asked."""
+    cfg, choice = ctx.cfg, ctx.grasp
+    if choice.target_r is None:  # a new grasp (not a new choice for this one)
+        choice.swap_this_grasp, choice.other_fingers = choice.other_fingers, False
+        choice.pregrasp_steps = 1
+    target = grasp_rotation(est, r, cfg, robot_side(ctx, est, p, r, arm_qpos))
+    if choice.quarter:
+        target = quarter_turn(target, r)
+    if cfg.grasp.rehearse_fingers and arm_qpos is not None and not is_lid(est, cfg):
+        target = rehearsed_fingers(ctx, est, p, r, arm_qpos, target)
+    if choice.swap_this_grasp:
+        target = target @ SWAP_FINGERS
+    choice.target_r = target
+    choice.target_for = np.array(est.grasp_point, dtype=np.float64)
+    choice.looks = [choice.target_for.copy()]
+    choice.kind_for, choice.kinds = part_kind(est, cfg), []
+    choice.lid = choice.kind_for == "lid"
+
+
+def robot_side(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
+               arm_qpos: np.ndarray | None) -> np.ndarray:
+    """Direction (3,) from ``est``'s grasp point to the robot's base: the base's position is recovered
+    from the arm's joint angles and the TCP pose (``p`` (3,), ``r`` (3, 3)) and kept; without joint
+    angles, the direction to the TCP (the hand comes from the robot's side)."""
+    if arm_qpos is not None and ctx.base is None:
+        ctx.base = base_in_world(np.asarray(arm_qpos, dtype=np.float64), pose_matrix(p, r))[:3, 3]
+    towards = ctx.base if ctx.base is not None else p
+    return np.asarray(towards, dtype=np.float64) - np.asarray(est.grasp_point, dtype=np.float64)
+
+
+def grasp_point_moved(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
+    """Whether ``est``'s grasp point is more than ``approach.rechoose_grasp_m`` from the one the grasp
+    orientation was chosen for, on each of the last ``approach.rechoose_looks`` looks (distinct
+    estimates), which agree with each other within that distance (False before one is chosen or with
+    ``rechoose_grasp_m`` 0)."""
+    cfg, choice = ctx.cfg.approach, ctx.grasp
+    if cfg.rechoose_grasp_m <= 0 or choice.target_r is None or choice.target_for is None:
+        return False
+    point = np.asarray(est.grasp_point, dtype=np.float64)
+    if not choice.looks or float(np.linalg.norm(point - choice.looks[-1])) > 1e-9:
+        # a new look; only the last rechoose_looks are ever compared
+        choice.looks = [*choice.looks, point.copy()][-cfg.rechoose_looks:]
+    recent = choice.looks
+    if len(recent) < cfg.rechoose_looks:
+        return False
+    target_for = choice.target_for
+    return all(float(np.linalg.norm(q - target_for)) > cfg.rechoose_grasp_m for q in recent) and all(
+        float(np.linalg.norm(q - recent[-1])) <= cfg.rechoose_grasp_m for q in recent)
+
+
+def part_kind_changed(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
+    """Whether, with ``approach.rechoose_part_kind``, ``est`` shows another
+    :func:`~agents.scripted.grasp_pose.part_kind` than the estimate the grasp orientation was chosen
+    for, on each of the last ``approach.rechoose_looks`` looks (a first look can tilt a door's hinge
+    into a lid's)."""
+    cfg, choice = ctx.cfg, ctx.grasp
+    if not cfg.approach.rechoose_part_kind or choice.kind_for is None:
+        return False
+    key = np.concatenate([est.grasp_point, est.direction]).astype(np.float64)
+    if choice.kind_key is None or float(np.abs(key - choice.kind_key).max()) > 1e-9:  # a new look
+        choice.kind_key = key
+        choice.kinds = [*choice.kinds, part_kind(est, cfg)][-cfg.approach.rechoose_looks:]
+    return len(choice.kinds) >= cfg.approach.rechoose_looks and all(
+        k != choice.kind_for for k in choice.kinds)
+
+
+def falling_on_its_own(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
+    """Whether, before its grasp, a part that :func:`~agents.scripted.grasp_pose.falls_open` is seen
+    falling open: at least ``falling_door.settle_above`` open and risen by ``falling_door.progress``
+    over the last ``falling_door.window`` steps (``falling_door.watch`` and ``done_above`` > 0; never
+    while lifting a lid)."""
+    cfg = ctx.cfg.falling_door
+    if not cfg.watch or cfg.done_above <= 0.0 or ctx.lift or not falls_open(est, ctx.cfg):
+        ctx.watch = []
+        return False
+    ctx.watch.append(float(est.state))
+    return ctx.watch[-1] >= cfg.settle_above and release.risen(ctx, ctx.watch)
+
+
+def rehearse_grasp(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
+                   arm_qpos: np.ndarray, rotation: np.ndarray) -> Rehearsal:
+    """Grasp and pull with TCP ``rotation`` (3, 3) rehearsed on the arm's kinematic model."""
+    cfg = ctx.cfg
+    approach = rotation[:, 2]
+    point = est.grasp_point
+    grasp_at = point + approach * cfg.approach.grasp_depth
+    u = unit(est.direction)
+    path: list[tuple[np.ndarray, np.ndarray]] = []
+    if est.joint_type == "revolute":
+        follow = 1.0 if is_vertical_hinge(est, cfg) else cfg.pull.revolute.wrist_follow
+        for delta in np.arange(0.05, max(cfg.pull.revolute.target - float(est.state), 0.0) + 1e-9, 0.05):
+            path.append((est.pivot + axis_angle_matrix(u, delta) @ (grasp_at - est.pivot),
+                         axis_angle_matrix(u, follow * delta) @ rotation))
+    else:
+        for delta in np.arange(0.01, max(cfg.pull.prismatic.target - float(est.state), 0.0) + 1e-9, 0.01):
+            path.append((grasp_at + u * delta, rotation))
+    pregrasp_at = point - approach * cfg.approach.pregrasp_offset
+    move = cfg.move
+    return rehearse(arm_qpos, pose_matrix(p, r), rotation, pregrasp_at, grasp_at, path,
+                    max_step_m=move.max_step_m, max_step_rad=move.max_step_rad,
+                    rotate_first_above=cfg.approach.rotate_first_above,
+                    rotate_first_steps=cfg.approach.rotate_first_steps, move_timeout=move.timeout_steps,
+                    pos_tolerance=move.pos_tolerance, rot_tolerance=move.rot_tolerance,
+                    pull_tolerance_m=cfg.grasp.rehearse_track_m)
+
+
+def rehearsed_fingers(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
+                      arm_qpos: np.ndarray, nearer: np.ndarray) -> np.ndarray:
+    """``nearer`` (3, 3), or the same approach with the fingers swapped if the rehearsal says the arm
+    reaches and pulls clearly better that way (``grasp.rehearse_fingers``)."""
+    cfg = ctx.cfg
+    other = nearer @ SWAP_FINGERS
+
+    def reaches(x: Rehearsal) -> bool:
+        return (x.grasp_error_m <= 2 * cfg.move.pos_tolerance
+                and x.grasp_error_rad <= 2 * cfg.move.rot_tolerance)
+
+    a = rehearse_grasp(ctx, est, p, r, arm_qpos, nearer)
+    b = rehearse_grasp(ctx, est, p, r, arm_qpos, other)
+    ctx.rehearsals = (a, b)
+    if reaches(b) and b.pull_share >= 1.0 and (
+            not reaches(a) or a.pull_share <= 1.0 - cfg.grasp.rehearse_margin):
+        return other
+    return nearer
