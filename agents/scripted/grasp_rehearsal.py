@@ -4,10 +4,18 @@ A parallel gripper can take a handle with its fingers either way round (the TCP 
 about its approach axis). When the two are about equally far from the hand's current rotation, which
 one the arm can reach and hold through the pull depends on its joint limits: one of them can end with
 a wrist joint at its limit, the fingers short of the handle or the pull stalling half-way (oven doors,
-whose horizontal bar makes the two orders a near tie). :func:`rehearse` plays the opener's moves on
-:mod:`agents.scripted.panda_kinematics`: from the measured joint angles, each control step moves the
-TCP goal by at most the opener's per-step caps and the damped least-squares IK follows it with every
-joint clamped to its limit, as the robot's joints stop at theirs. World frame, metres, radians.
+whose horizontal bar makes the two orders a near tie), or a door whose turn is mostly a roll about
+the approach that only wrist joint 7 gives, pinned at its limit part-way (Meta-World's lever door).
+:func:`rehearse` plays the opener's moves on :mod:`agents.scripted.panda_kinematics`, the Panda's URDF
+model and its ``pd_ee_delta_pose`` controller's own IK: from the measured joint angles, each control
+step moves the TCP goal by at most the opener's per-step caps, the controller's IK (which does not know
+the joint limits) solves for it and every joint stops at its limit, as the simulated joints do. A
+joint pinned at its limit is not made up for by the others (the controller's solution leaves the
+pose error to that joint), so the error grows as the pull goes on: the rehearsal counts a pull
+waypoint as followed while the TCP is within ``pull_tolerance_m`` and ``pull_tolerance_rad`` of it.
+The drive's lag (the arm covers about 40% of a step's joint change within the step) slows the arm but
+does not change where it can go, so the rehearsal moves the joints the whole way each step. World
+frame, metres, radians.
 """
 
 from __future__ import annotations
@@ -24,7 +32,7 @@ from agents.scripted.panda_kinematics import base_in_world, ik_step, pose_error,
 class Rehearsal:
     """How a rehearsed grasp went: the TCP's distance (m) and rotation error (rad) from the grasp pose
     after the approach, and the share (0..1) of the pull path the TCP followed within the tracking
-    tolerance before it first fell behind."""
+    tolerances (position and rotation) before it first fell behind."""
 
     grasp_error_m: float
     grasp_error_rad: float
@@ -40,6 +48,7 @@ class _Arm:
         self.max_step_m, self.max_step_rad = max_step_m, max_step_rad
 
     def error(self, goal_in_world: np.ndarray) -> tuple[float, float]:
+        """The TCP's position (m) and rotation (rad) error from ``goal_in_world`` (4, 4)."""
         err = pose_error(self.world_to_base @ goal_in_world, tcp_pose(self.q))
         return float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
 
@@ -67,11 +76,15 @@ def rehearse(arm_qpos: np.ndarray, tcp_in_world: np.ndarray, rotation: np.ndarra
              pregrasp: np.ndarray, grasp: np.ndarray, pull_path: list[tuple[np.ndarray, np.ndarray]],
              *, max_step_m: float, max_step_rad: float, rotate_first_above: float,
              rotate_first_steps: int, move_timeout: int, pos_tolerance: float, rot_tolerance: float,
-             pull_tolerance_m: float = 0.02, steps_per_waypoint: int = 2) -> Rehearsal:
+             pull_tolerance_m: float = 0.02, pull_tolerance_rad: float = 0.25,
+             steps_per_waypoint: int = 2) -> Rehearsal:
     """Rehearse turning the hand to ``rotation`` (3, 3), moving to the ``pregrasp`` and ``grasp``
     positions (3,), then following ``pull_path`` (world (position, rotation) waypoints from the grasp
     out, ``steps_per_waypoint`` control steps each), from the arm's joint angles ``arm_qpos`` (7,) rad
-    and its TCP pose ``tcp_in_world`` (4, 4). The caps, tolerances and timeouts are the opener's."""
+    and its TCP pose ``tcp_in_world`` (4, 4). The caps, tolerances and timeouts are the opener's. A
+    waypoint is followed when the TCP ends within ``pull_tolerance_m`` m and ``pull_tolerance_rad`` rad
+    of it: a hand turned 0.25 rad (15 deg) off the way the part turns twists a bar held across the
+    finger pads towards their edge, where it slips out as the lag grows."""
     arm = _Arm(arm_qpos, tcp_in_world, max_step_m, max_step_rad)
     pregrasp_goal = pose_matrix(pregrasp, rotation)
     for _ in range(rotate_first_steps):
@@ -86,7 +99,8 @@ def rehearse(arm_qpos: np.ndarray, tcp_in_world: np.ndarray, rotation: np.ndarra
         goal = pose_matrix(position, rot)
         for _ in range(steps_per_waypoint):
             arm.step(goal)
-        if arm.error(goal)[0] > pull_tolerance_m:
+        perr, rerr = arm.error(goal)
+        if perr > pull_tolerance_m or rerr > pull_tolerance_rad:
             break
         followed += 1
     share = followed / len(pull_path) if pull_path else 1.0
