@@ -142,9 +142,13 @@ class GraspConfig:
     (a share in (0, 1]): when both fall behind late, the model cannot tell them apart."""
     rehearse_track_m: float = 0.02
     """A rehearsed TCP farther than this (m) from the pull path has fallen behind."""
+    rehearse_track_rad: float = 0.25
+    """A rehearsed TCP turned more than this (rad) from the pull path's orientation has fallen behind:
+    a wrist pinned at its limit lets the hand's roll lag the part while its position keeps up, and
+    the handle twists out of the fingers."""
 
     def validate(self) -> None:
-        _positive(self, "hold_gap", "rehearse_track_m", where="grasp.")
+        _positive(self, "hold_gap", "rehearse_track_m", "rehearse_track_rad", where="grasp.")
         _at_least_one(self, "close_steps", where="grasp.")
         require(0.0 < self.rehearse_margin <= 1.0,
                 f"grasp.rehearse_margin must be in (0, 1] (a share of the pull path), "
@@ -519,6 +523,7 @@ LEGACY_KEYS: dict[str, str] = {
     "rehearse_fingers": "grasp.rehearse_fingers",
     "rehearse_margin": "grasp.rehearse_margin",
     "rehearse_track_m": "grasp.rehearse_track_m",
+    "rehearse_track_rad": "grasp.rehearse_track_rad",
     "stall_steps": "pull.stall_steps",
     "slip_distance": "pull.slip_distance",
     "slip_steps": "pull.slip_steps",

@@ -87,7 +87,7 @@ def test_shipped_configs_load() -> None:
     ({"residual": {"enabled": True, "scale": 0.0}}, "residual.scale"),
     ({"residual": {"enable": True}}, "enable"),
     ({"ppo": {"log_std_init": 3.0}}, "log_std_init"),
-    ({"residual": {"enabled": True, "opener": {"arc_fit_min_angle": 0.0}}}, "arc_fit_min_angle"),
+    ({"residual": {"enabled": True, "opener": {"arc_fit_min_angle": 0.0}}}, "arc_fit.min_angle"),
     ({"residual": {"enabled": True, "opener": {"arcfit": False}}}, "arcfit"),
 ])
 def test_bad_config_values_are_rejected(changes: dict, match: str) -> None:

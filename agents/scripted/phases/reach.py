@@ -271,7 +271,8 @@ def rehearse_grasp(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r:
                     rotate_first_above=cfg.approach.rotate_first_above,
                     rotate_first_steps=cfg.approach.rotate_first_steps, move_timeout=move.timeout_steps,
                     pos_tolerance=move.pos_tolerance, rot_tolerance=move.rot_tolerance,
-                    pull_tolerance_m=cfg.grasp.rehearse_track_m)
+                    pull_tolerance_m=cfg.grasp.rehearse_track_m,
+                    pull_tolerance_rad=cfg.grasp.rehearse_track_rad)
 
 
 def rehearsed_fingers(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
