@@ -21,9 +21,10 @@ import sys
 import tempfile
 from pathlib import Path
 
+from revision_ab import abba, base_worktree
+
 from capt_common.json_report import script_command, write_json
 
-ROOT = Path(__file__).resolve().parent.parent
 CATEGORIES = ["laptop", "oven", "washing_machine", "eyeglasses", "drawer_cabinet", "cabinet_door"]
 
 
@@ -52,17 +53,11 @@ def main() -> None:
     parser.add_argument("--timing-clouds", type=int, default=200, help="timed calls per evaluate run")
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args()
-    base_tree = Path(tempfile.mkdtemp(prefix="capt_ab_base_"))
-    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(base_tree), args.base],
-                   check=True, capture_output=True)
     results = {}
-    try:
+    with base_worktree(args.base) as base_tree:
         for cat in args.categories:
-            runs: dict[str, list[dict]] = {"base": [], "tree": []}
-            for _ in range(args.rounds):
-                for side in ("base", "tree", "tree", "base"):
-                    runs[side].append(evaluate(base_tree if side == "base" else ROOT, cat, args.data,
-                                               args.timing_clouds))
+            runs = abba(lambda tree, cat=cat: evaluate(tree, cat, args.data, args.timing_clouds), base_tree,
+                        args.rounds)
             same = all(r["table"] == runs["base"][0]["table"] for side in runs.values() for r in side)
             row = {side: statistics.median(r["ms"] for r in rs) for side, rs in runs.items()}
             row.update(metrics_equal=same, table=runs["tree"][0]["table"],
@@ -72,9 +67,6 @@ def main() -> None:
             results[cat] = row
             print(f"{cat}: base {row['base']:.1f} ms, tree {row['tree']:.1f} ms per cloud "
                   f"(x{row['base'] / row['tree']:.2f}); metrics equal to printed digits: {same}", flush=True)
-    finally:
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(base_tree)],
-                       check=False, capture_output=True)
     write_json(args.json, {"base": args.base, "threads": os.environ.get("OMP_NUM_THREADS"),
                            "results": results}, script_command())
 

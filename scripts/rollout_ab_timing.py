@@ -21,9 +21,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-from capt_common.json_report import script_command, write_json
+from revision_ab import abba, base_worktree
 
-ROOT = Path(__file__).resolve().parent.parent
+from capt_common.json_report import script_command, write_json
 
 # Runs inside the side's code: make_env moved from agents.scripted.rollout to capt_env in this tree.
 EPISODES = r"""
@@ -70,17 +70,12 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=1, help="ABBA blocks per category")
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args()
-    base_tree = Path(tempfile.mkdtemp(prefix="capt_ab_base_"))
-    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(base_tree), args.base],
-                   check=True, capture_output=True)
     results = {}
-    try:
+    with base_worktree(args.base) as base_tree:
         for cat in args.categories:
-            runs: dict[str, list[dict]] = {"base": [], "tree": []}
-            for _ in range(args.rounds):
-                for side in ("base", "tree", "tree", "base"):
-                    runs[side] += run_side(base_tree if side == "base" else ROOT, cat, args.first_seed,
-                                           args.episodes)
+            blocks = abba(lambda tree, cat=cat: run_side(tree, cat, args.first_seed, args.episodes),
+                          base_tree, args.rounds)
+            runs = {side: [e for block in eps for e in block] for side, eps in blocks.items()}
             row = {side: {"seconds_per_episode_mean": statistics.mean(e["seconds"] for e in eps),
                           "seconds_per_step_mean": (sum(e["seconds"] for e in eps)
                                                     / sum(e["steps"] for e in eps)),
@@ -91,9 +86,6 @@ def main() -> None:
             print(f"{cat}: base {row['base']['seconds_per_episode_mean']:.1f} s, tree "
                   f"{row['tree']['seconds_per_episode_mean']:.1f} s per episode (x{row['speedup']:.2f}); "
                   f"success {row['base']['success']:.2f} / {row['tree']['success']:.2f}", flush=True)
-    finally:
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(base_tree)],
-                       check=False, capture_output=True)
     write_json(args.json, {"base": args.base, "threads": os.environ.get("OMP_NUM_THREADS"),
                            "results": results}, script_command())
 
