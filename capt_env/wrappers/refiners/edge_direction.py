@@ -5,8 +5,8 @@ an edge's direction in the part's plane. A single view's estimate of a lid's hin
 the lid's plane by 5-25 deg, which moves the lid's far edge, where the grasp point is looked for, to
 a corner. The part's in-plane points are fitted with their minimum-area rectangle, and the direction
 is turned onto the rectangle's edge nearest to it (its sign kept). It runs on the part's own points,
-not the coplanar panel: rectangles fitted to the panel turned the line 5-11 deg off during pulls
-(cabinet door seeds 153, 178 and 181 failed with it, opened without).
+not the coplanar panel: a panel's rectangle includes the frame around an open door, and turned the
+line 5-11 deg off during pulls.
 Must not fire: on a prismatic joint; on a part that is not a rectangle (its convex hull fills less
 than ``min_fill`` of the rectangle: a round washing-machine door) or is a bar (an eyeglasses temple);
 when the nearest edge is more than ``max_turn`` rad away or the direction is more than 60 deg out of

@@ -5,9 +5,9 @@ share one flat front with one handle each, stacked along world up. The network s
 from the body well but often gives a drawer its neighbour's label, so its own label can name the
 wrong handle; counting the handles on the front from the bottom cannot. The front's plane is the
 drawers' union as segmented, or the target drawer's alone when that union is not flat (the network
-gave a drawer some of the carcass's top or side: drawer seed 108), and it must face along the
-slide. A handle in a stack needs only ``handle_share`` of the points a lone handle does: counting
-from the bottom, a missed low handle names the next one up (drawer seed 30).
+gave a drawer some of the carcass's top or side), and it must face along the slide. A handle in a
+stack needs only ``handle_share`` of the points a lone handle does: a low or partly hidden bar shows
+few points, and counting from the bottom, a missed low handle names the next one up.
 Must not fire: a revolute joint, a model with fewer than two prismatic joints, a front that is not
 flat or does not face along the slide, or fewer than k + 1 handles in view (the label decides).
 """
