@@ -888,3 +888,16 @@ def test_opens_a_drawer_with_noisy_oracle_perception() -> None:
     finally:
         env.close()
     assert result.success, result
+
+
+def test_a_closed_door_the_view_reads_open_is_pulled_from_closed() -> None:
+    """The first pull counts from closed, whatever the perceived state; a re-grasp counts from the
+    state perceived then (a part the hand has moved)."""
+    opener = ScriptedOpener()
+    est = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3]), 0.9,
+                            np.array([-0.1, 0.2, 0.3]))
+    start = np.array([-0.1, 0.2, 0.3])
+    start_pull(opener.ctx, start, np.eye(3), est, "closed")
+    assert opener.ctx.pull.grasp_state == 0.0
+    start_pull(opener.ctx, start, np.eye(3), est, "again")
+    assert opener.ctx.pull.grasp_state == pytest.approx(0.9)

@@ -29,7 +29,12 @@ from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, unit
 def start_pull(ctx: OpenerContext, p: np.ndarray, r: np.ndarray, est: JointAxisEstimate, why: str) -> Pull:
     """Begin a pull from the TCP pose ``p`` (3,), ``r`` (3, 3) on ``est``: the phase to enter."""
     track = ctx.pull
-    track.grasp_p, track.grasp_r, track.grasp_state = p.copy(), r.copy(), est.state
+    # the first pull counts from closed: a single view's state of a part no hand has moved yet can
+    # read a closed door tens of degrees open, and the pull would stop that much short (tasks start
+    # parts within a few percent of closed; one that starts open ends at its end stop instead)
+    first = track.grasp_p is None
+    track.grasp_p, track.grasp_r = p.copy(), r.copy()
+    track.grasp_state = 0.0 if first else est.state
     track.grasp_u = unit(est.direction)
     track.falls = falls_open(est, ctx.cfg)
     track.history = []
