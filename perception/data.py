@@ -69,6 +69,10 @@ class Sample:
     category: str = ""
     instance_id: int = 0
 
+    def object_points(self) -> np.ndarray:
+        """(M, 3) float64: the points on the object (part label >= 0), world frame, metres."""
+        return np.asarray(self.points, np.float64)[np.asarray(self.part_labels) >= 0]
+
     def arrays(self) -> dict[str, np.ndarray]:
         """The npz arrays with their canonical dtypes."""
         return {

@@ -117,7 +117,7 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
         cfg = est.config.model
         ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples, pose=test_pose)
         samples = [ds.posed(i) for i in range(len(ds))]
-        clean = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]
+        clean = [s.object_points() for s in samples]
         clouds = [corrupt_cloud(c, i, corruption) for i, c in enumerate(clean)] if corruption else clean
         for c in clouds[:WARM_UP_CALLS]:
             est.predict(c)

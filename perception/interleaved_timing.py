@@ -15,7 +15,6 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
 import torch
 
 from capt_common.json_report import script_command, write_json
@@ -35,7 +34,7 @@ def time_category(category: str, data_root: Path, clouds: int, rounds: int, swit
     pts = []
     for i in range(len(ds)):
         s = ds.sample(i)
-        pts.append(np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0])
+        pts.append(s.object_points())
     x = torch.randn(1, est.config.model.num_points, 3, generator=torch.Generator().manual_seed(0))
     predict: dict[bool, list[float]] = {True: [], False: []}
     forward: dict[bool, list[float]] = {True: [], False: []}

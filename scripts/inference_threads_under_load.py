@@ -52,11 +52,7 @@ def _clouds(data: Path, category: str, count: int) -> list[np.ndarray]:
 
     cfg = ArticulationEstimator.from_checkpoint(default_checkpoint(category)).config.model
     ds = CaptShardDataset(data / category, "test", cfg, augment=False, max_samples=count)
-    out = []
-    for i in range(len(ds)):
-        s = ds.sample(i)
-        out.append(np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0])
-    return out
+    return [ds.sample(i).object_points() for i in range(len(ds))]
 
 
 def main() -> None:

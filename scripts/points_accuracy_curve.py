@@ -35,7 +35,7 @@ def curve(category: str, data: Path, split: str, counts: list[int]) -> dict[int,
     base = ckpt.config.model
     ds = CaptShardDataset(data / category, split, base, augment=False)
     samples = [ds.posed(i) for i in range(len(ds))]
-    clouds = [np.asarray(s.points, np.float64)[np.asarray(s.part_labels) >= 0] for s in samples]
+    clouds = [s.object_points() for s in samples]
     out = {}
     for n in counts:
         config = replace(ckpt.config, model=replace(base, num_points=n))

@@ -126,7 +126,6 @@ def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path, test_
     stray points included) coloured by predicted part,
     axes red/green. Named ``<category>_<variant>.png``, with the checkpoint's position appended (``_2``)
     when an earlier checkpoint of the same variant already took that name."""
-    import numpy as np
 
     from perception.corruption import corrupt_cloud
     from perception.data import CaptShardDataset
@@ -138,7 +137,7 @@ def _figures(checkpoints: list[str], data: str, split: str, out_dir: Path, test_
         est = ArticulationEstimator.from_checkpoint(path, outlier_filter=outlier_filter)
         sample = CaptShardDataset(data, split, est.config.model, augment=False, max_samples=1,
                                   pose=test_pose).posed(0)
-        cloud = np.asarray(sample.points, np.float64)[np.asarray(sample.part_labels) >= 0]
+        cloud = sample.object_points()
         if corruption is not None:
             cloud = corrupt_cloud(cloud, 0, corruption)
         pred = est.predict(cloud)

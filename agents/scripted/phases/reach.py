@@ -85,6 +85,16 @@ class _Reach(OpenerPhase):
         """TCP goal position (3,) and gripper action; may also set ``ctx.grasp.target_r``."""
         raise NotImplementedError
 
+    @staticmethod
+    def along_approach(ctx: OpenerContext, est: JointAxisEstimate, depth: float) -> tuple[np.ndarray, float]:
+        """The grasp point (a lid's front lip) moved ``depth`` m along the approach axis (negative:
+        outside the part), with the open gripper's action."""
+        cfg, choice = ctx.cfg, ctx.grasp
+        assert choice.target_r is not None
+        point = grasp_target(est, cfg) if choice.lid else est.grasp_point
+        return (point + choice.target_r[:, 2] * depth,
+                gripper_action(cfg.lid.gap if choice.lid else cfg.approach.gap))
+
     def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
         """The phase after the move ended (``ctx.move.reach_why`` says how)."""
         raise NotImplementedError
@@ -97,12 +107,7 @@ class PreGrasp(_Reach):
     phase = Phase.PREGRASP
 
     def goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float]:
-        cfg, choice = ctx.cfg, ctx.grasp
-        assert choice.target_r is not None
-        approach = choice.target_r[:, 2]
-        point = grasp_target(est, cfg) if choice.lid else est.grasp_point
-        return (point - approach * cfg.approach.pregrasp_offset,
-                gripper_action(cfg.lid.gap if choice.lid else cfg.approach.gap))
+        return self.along_approach(ctx, est, -ctx.cfg.approach.pregrasp_offset)
 
     def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
         return LiftSlideUnder(ctx.move.reach_why) if ctx.lift else Approach(ctx.move.reach_why)
@@ -114,12 +119,7 @@ class Approach(_Reach):
     phase = Phase.APPROACH
 
     def goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float]:
-        cfg, choice = ctx.cfg, ctx.grasp
-        assert choice.target_r is not None
-        approach = choice.target_r[:, 2]
-        point = grasp_target(est, cfg) if choice.lid else est.grasp_point
-        return (point + approach * cfg.approach.grasp_depth,
-                gripper_action(cfg.lid.gap if choice.lid else cfg.approach.gap))
+        return self.along_approach(ctx, est, ctx.cfg.approach.grasp_depth)
 
     def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
         return grasp.Close(ctx.move.reach_why)
