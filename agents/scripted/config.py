@@ -4,7 +4,8 @@ metres, radians, control steps at 20 Hz).
 ``ScriptedOpenerConfig`` groups the options by what they govern: ``move`` (every straight move of the
 hand), ``approach`` (the pre-grasp and the approach), ``grasp`` (closing the fingers and choosing the
 finger order), ``pull``, ``release``, ``recovery`` (grasping again), and one group per part kind whose
-rules differ (``side_door``, ``lid``, ``falling_door``, ``drawer``, ``sliding_panel``). Each option's
+rules differ (``side_door``, ``lid``, ``falling_door``, ``drawer``, ``sliding_panel``; each read by its
+strategy in :mod:`agents.scripted.part_strategies`). Each option's
 docstring says why it has its value. YAML files mirror the tree (``approach: {pitch: 0.55}``); the
 flat keys of earlier releases (``approach_pitch: 0.55``) still load, mapped by :data:`LEGACY_KEYS`
 with a warning (see :func:`upgrade_legacy_keys`). The traced episodes behind the defaults are in

@@ -13,8 +13,10 @@ and runs the current phase; each phase (:mod:`agents.scripted.phases`) is a smal
 
 1. :class:`~agents.scripted.phases.reach.PreGrasp`: open the gripper to the approach gap, turn the hand
    in place to the grasp orientation and move outside the grasp point along the part's outward normal,
-   the fingers closing across the handle (:mod:`agents.scripted.grasp_pose`; the finger order checked
-   on the arm's kinematic model, :mod:`agents.scripted.grasp_rehearsal`).
+   the fingers closing across the handle, as the part-kind strategy chosen with the grasp says
+   (:mod:`agents.scripted.part_strategies`: lid, side door, door that falls open, other hinge,
+   drawer, sliding panel; the finger order checked on the arm's kinematic model,
+   :mod:`agents.scripted.grasp_rehearsal`).
 2. :class:`~agents.scripted.phases.reach.Approach` to the grasp point, then
    :class:`~agents.scripted.phases.grasp.Close`.
 3. :class:`~agents.scripted.phases.pull.Pull`: the part's state measured by the hand's own travel, the

@@ -1,5 +1,6 @@
 """The per-episode state the opener's phases share (:class:`OpenerContext`), world frame, metres,
-radians, control steps."""
+radians, control steps, among it the part-kind strategy chosen with the grasp under way
+(:class:`GraspChoice`, :meth:`OpenerContext.grip`)."""
 
 from __future__ import annotations
 
@@ -11,27 +12,30 @@ import numpy as np
 from agents.scripted.config import ScriptedOpenerConfig
 from agents.scripted.grasp_rehearsal import Rehearsal
 from agents.scripted.motion_axis import MotionAxis
+from agents.scripted.part_strategies import Drawer, Hinged, Lid, PartStrategy
 from agents.scripted.phases.base import Look, MoveTracker, OpenerPhase, Phase
+from capt_env.wrappers.estimate import JointAxisEstimate
 
 
 @dataclass
 class GraspChoice:
     """The grasp being made: its TCP rotation and what it was chosen for."""
 
+    cfg: ScriptedOpenerConfig = field(repr=False)
+    """The opener's options (for :attr:`lid`'s setter)."""
     target_r: np.ndarray | None = None
     """TCP rotation (3, 3) to grasp with; None: choose it on the next pre-grasp step (a new grasp)."""
     target_for: np.ndarray | None = None
     """The grasp point (3,) m ``target_r`` was chosen for."""
     looks: list[np.ndarray] = field(default_factory=list)
     """The grasp points (3,) of the last ``approach.rechoose_looks`` looks (distinct estimates)."""
-    kind_for: str | None = None
-    """The part kind (:func:`~agents.scripted.grasp_pose.part_kind`) ``target_r`` was chosen for."""
+    strategy: PartStrategy | None = None
+    """The part-kind strategy (:func:`~agents.scripted.part_strategies.strategy_for`) ``target_r`` was
+    chosen with; None before a grasp is chosen."""
     kinds: list[str] = field(default_factory=list)
-    """The part kinds of the last ``approach.rechoose_looks`` looks since then."""
+    """The part kinds (``grasp_kind``) of the last ``approach.rechoose_looks`` looks since then."""
     kind_key: np.ndarray | None = None
     """The last look's grasp point and axis direction (6,), to tell a new look."""
-    lid: bool = False
-    """The part is a lid (gripped from above across its lip), as the grasp was chosen."""
     swap_this_grasp: bool = False
     """This grasp turns the fingers the other way round (see ``other_fingers``)."""
     other_fingers: bool = False
@@ -40,6 +44,17 @@ class GraspChoice:
     """Grasps turn the fingers a quarter turn about the approach (``recovery.quarter_turn``)."""
     pregrasp_steps: int = 0
     """Steps this grasp has spent in the pre-grasp, moves started over included."""
+
+    @property
+    def lid(self) -> bool:
+        """The part is a lid (gripped from above across its lip), as the grasp was chosen: its strategy
+        is a :class:`~agents.scripted.part_strategies.Lid`. Set True, the grasp takes the lid's
+        strategy; set False, it forgets its strategy."""
+        return isinstance(self.strategy, Lid)
+
+    @lid.setter
+    def lid(self, value: bool) -> None:
+        self.strategy = Lid(self.cfg) if value else None
 
 
 @dataclass
@@ -66,7 +81,9 @@ class PullTrack:
     slip_count: int = 0
     """Steps running the hand has been off the grasp point with its fingers closed on nothing."""
     falls: bool = False
-    """The part falls open when let go (:func:`~agents.scripted.grasp_pose.falls_open`), as the pull began."""
+    """The part falls open when let go: the estimate the pull began with shows a
+    :class:`~agents.scripted.part_strategies.FallingDoor` (a door near level, its handle hidden by the
+    hand, can be far off later)."""
 
 
 @dataclass
@@ -96,7 +113,8 @@ class OpenerContext:
     """One entry per phase entered: ``{"step", "phase", "why"}``, a pull's with its ``"grip"``
     (``"none"``, ``"held"``, ``"lost"``; see :func:`agents.scripted.phases.pull.record_grip`)."""
     move: MoveTracker = field(default_factory=MoveTracker)
-    grasp: GraspChoice = field(default_factory=GraspChoice)
+    grasp: GraspChoice = field(init=False)
+    """The grasp being made and the strategy it was chosen with."""
     pull: PullTrack = field(default_factory=PullTrack)
     axis: MotionTrack = field(default_factory=MotionTrack)
     regrasps: int = 0
@@ -119,6 +137,19 @@ class OpenerContext:
     """The robot base's position (3,) m, once joint angles are seen."""
     rehearsals: tuple[Rehearsal, Rehearsal] | None = None
     """The last finger-order rehearsal (nearer order, other order)."""
+
+    def __post_init__(self) -> None:
+        self.grasp = GraspChoice(self.cfg)
+
+    def grip(self, est: JointAxisEstimate) -> PartStrategy:
+        """The strategy of the grasp under way (``grasp.strategy``). Before any grasp was chosen (a
+        phase entered directly), a part that is not a lid (only a grasp chosen for one makes it a
+        lid's): :class:`~agents.scripted.part_strategies.Hinged` or
+        :class:`~agents.scripted.part_strategies.Drawer` by ``est``'s joint type, whose pull rules are
+        those every kind but the lid shares."""
+        if self.grasp.strategy is not None:
+            return self.grasp.strategy
+        return Hinged(self.cfg) if est.joint_type == "revolute" else Drawer(self.cfg)
 
     def enter(self, phase: OpenerPhase) -> None:
         """Enter ``phase``: log it (unless its ``why`` is None: it continues the phase before) and

@@ -1,5 +1,6 @@
 """Closing the fingers on the handle, and what the finger gap then says: held (pull), or closed on
-nothing (lift a lid from below, or grasp again with the fingers turned)."""
+nothing (what then is the grasp's part-kind strategy's: a lid's lip is lifted from below, other parts
+are grasped again with the fingers turned)."""
 
 from __future__ import annotations
 
@@ -23,12 +24,13 @@ class Close(OpenerPhase):
             return action, self
         gap = look.finger_gap
         empty = gap is not None and gap < cfg.grasp.hold_gap
-        if choice.lid and cfg.lid.lift.enabled and not ctx.lift and empty:
+        grip = ctx.grip(look.est)
+        if grip.lifts_from_below(ctx.lift) and empty:
             # the fingers closed on nothing across the lid's lip (wider than the open fingers): back
             # off, then lift the lid from below
             ctx.lift = ctx.grasp_again = True
             return action, release.Release("empty")
-        if (not choice.lid and cfg.recovery.other_fingers and empty
+        if (grip.turns_fingers_on_miss and cfg.recovery.other_fingers and empty
                 and ctx.regrasps < cfg.recovery.max_regrasps):
             assert gap is not None
             # the fingers closed on nothing: back off and grasp again. If the approach timed out or a

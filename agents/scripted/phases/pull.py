@@ -1,7 +1,10 @@
 """The pull: the held part is moved along its estimated arc (revolute) or line (prismatic), its state
 measured by the hand's own travel every step (free of the perceived state's noise), the axis corrected
 by the holding hand's path (``pull.arc_fit``) or the part's (``pull.motion_axis``). It ends at the
-target, on a stall, at a prismatic part's end stop, or when the hand slips off."""
+target, on a stall, at a prismatic part's end stop, or when the hand slips off. The grasp's part-kind
+strategy (``ctx.grip``) gives the target, the lead, how far the hand turns, what counts towards a slip
+and whether a stall far open is an end stop; the joint type the current look shows decides arc or
+line."""
 
 from __future__ import annotations
 
@@ -10,8 +13,8 @@ from dataclasses import replace
 import numpy as np
 
 from agents.scripted.geometry import axis_angle_matrix, fit_circle, off_axis, swept_angle
-from agents.scripted.grasp_pose import falls_open, is_vertical_hinge
 from agents.scripted.motion_axis import fit_motion_axis
+from agents.scripted.part_strategies import PartStrategy, strategy_for
 from agents.scripted.phases import reach, release
 from agents.scripted.phases.base import (
     GRIPPER_CLOSE,
@@ -36,7 +39,7 @@ def start_pull(ctx: OpenerContext, p: np.ndarray, r: np.ndarray, est: JointAxisE
     track.grasp_p, track.grasp_r = p.copy(), r.copy()
     track.grasp_state = 0.0 if first else est.state
     track.grasp_u = unit(est.direction)
-    track.falls = falls_open(est, ctx.cfg)
+    track.falls = strategy_for(est, ctx.cfg).falls_open
     track.history = []
     track.pulled = [p.copy()]
     track.held = [p.copy()]
@@ -55,7 +58,7 @@ class Pull(OpenerPhase):
         cfg, look, track = ctx.cfg, ctx.now, ctx.pull
         assert look is not None and track.grasp_p is not None and track.grasp_r is not None
         est, p, r, finger_gap, arm_qpos = look.est, look.p, look.r, look.finger_gap, look.arm_qpos
-        lid = ctx.grasp.lid
+        grip = ctx.grip(est)
         revolute = est.joint_type == "revolute"
         u = unit(est.direction)
         if track.grasp_u is not None and float(u @ track.grasp_u) < 0.0:
@@ -76,10 +79,7 @@ class Pull(OpenerPhase):
         # a drawer runs freely up to its end stop, where the hand brakes before the handle slides out
         # of the fingers: that is the limit, and grasping again would chase a part that is open
         at_limit = not revolute and braked(ctx)
-        if revolute:
-            target = cfg.lid.target if lid else cfg.pull.revolute.target
-        else:
-            target = cfg.pull.prismatic.target
+        target = grip.pull_target(revolute)
         min_progress = cfg.pull.revolute.stall_progress if revolute else cfg.pull.prismatic.stall_progress
         # progress over the last stall_steps, measured about the pivot in use now (arc_fit may
         # have moved it, which changes the state read along the whole path, not the part's motion)
@@ -102,8 +102,8 @@ class Pull(OpenerPhase):
                 # hand and the perception must say so: fingers slipping along the handle carry the
                 # hand round the arc ahead of the door
                 ctx.grasp_again = False
-            if (stalled and revolute and not lid and not falls and holding and not wrist_stuck
-                    and 0.0 < cfg.pull.revolute.stop_above <= state):
+            if (stalled and revolute and grip.stall_can_be_end_stop and not falls and holding
+                    and not wrist_stuck and 0.0 < cfg.pull.revolute.stop_above <= state):
                 # held far open and the arm still in range: the part is at its end stop, and reaching
                 # for the handle again would knock it back
                 ctx.grasp_again = False
@@ -118,9 +118,7 @@ class Pull(OpenerPhase):
                 # other way
                 ctx.grasp.other_fingers = True
             return hold(GRIPPER_CLOSE), release.Release(why)
-        away = p - np.asarray(est.grasp_point, dtype=np.float64)
-        if lid and cfg.lid.slip_off_axis:  # a lid is revolute (part_kind)
-            away = off_axis(away, u)  # along its hinge, a lid's far edge is all the same to the hand
+        away = grip.slip_offset(p - np.asarray(est.grasp_point, dtype=np.float64), u)
         far = float(np.linalg.norm(away)) > cfg.pull.slip_distance and not holding
         track.slip_count = track.slip_count + 1 if far else 0
         slipped = track.slip_count >= cfg.pull.slip_steps
@@ -143,37 +141,32 @@ class Pull(OpenerPhase):
             ctx.regrasps += 1
             ctx.grasp.target_r = None
             return hold(GRIPPER_OPEN), reach.pregrasp(ctx, "slip")
-        p_des, r_des = pull_pose(ctx, est, u, pivot, state, revolute)
+        p_des, r_des = pull_pose(ctx, grip, est, u, pivot, state, revolute)
         action, _, _ = goto(ctx, p, r, p_des, r_des, GRIPPER_CLOSE)
         return action, self
 
 
-def pull_pose(ctx: OpenerContext, est: JointAxisEstimate, u: np.ndarray, pivot: np.ndarray, state: float,
-              revolute: bool) -> tuple[np.ndarray, np.ndarray]:
+def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u: np.ndarray,
+              pivot: np.ndarray, state: float, revolute: bool) -> tuple[np.ndarray, np.ndarray]:
     """The TCP goal (position (3,), rotation (3, 3)) of a pull step: the grasp pose moved with the part
-    to ``state + lead``, rotated about unit axis ``u`` through ``pivot`` or shifted along ``u``."""
-    cfg, track, lid = ctx.cfg, ctx.pull, ctx.grasp.lid
+    to ``state + lead``, rotated about unit axis ``u`` through ``pivot`` (moved towards it by the
+    strategy ``grip``'s inward slide; the hand turned by its share) or shifted along ``u``."""
+    cfg, track = ctx.cfg, ctx.pull
     assert track.grasp_p is not None and track.grasp_r is not None
     if not revolute:
         delta = state - track.grasp_state + cfg.pull.prismatic.lead
         return track.grasp_p + u * delta, track.grasp_r
-    lifting = lid and ctx.lift
-    lift = cfg.lid.lift
-    delta = state - track.grasp_state + (lift.lead if lifting else cfg.pull.revolute.lead)
+    delta = state - track.grasp_state + grip.pull_lead(ctx.lift)
     p_des = pivot + axis_angle_matrix(u, delta) @ (track.grasp_p - pivot)
-    if lifting and lift.inward > 0.0:
+    inward = grip.inward(ctx.lift)
+    if inward > 0.0:
         # lifting from below, the fingertips slide towards the hinge as the lid turns: off the lid's
         # own arc (an estimated hinge a centimetre or two off), they stay under it
         radial = off_axis(p_des - pivot, u)
         radius = float(np.linalg.norm(radial))
         if radius > 1e-6:
-            p_des = p_des - min(lift.inward * max(delta, 0.0), 0.5 * radius) * radial / radius
-    if is_vertical_hinge(est, cfg):
-        follow = 1.0
-    elif lid:
-        follow = lift.wrist_follow if ctx.lift else cfg.lid.wrist_follow
-    else:
-        follow = cfg.pull.revolute.wrist_follow
+            p_des = p_des - min(inward * max(delta, 0.0), 0.5 * radius) * radial / radius
+    follow = grip.hand_turn(est, ctx.lift)
     return p_des, axis_angle_matrix(u, follow * delta) @ track.grasp_r
 
 

@@ -2,26 +2,19 @@
 point), the approach (in along the approach axis), and the same two moves of the lift from below (a
 lid whose lip is wider than the open fingers: the closed fingertips line up in front of the lip, then
 slide in under it). The grasp orientation is chosen as a grasp's pre-grasp starts, and again early in
-it when the perceived grasp point or part kind changes (``approach.rechoose_*``)."""
+it when the perceived grasp point or part kind changes (``approach.rechoose_*``), together with the
+part-kind strategy (:mod:`agents.scripted.part_strategies`) the grasp keeps: it says where the TCP
+grips, how the hand is turned, the approach gap and whether the finger orders are rehearsed."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from agents.scripted.geometry import axis_angle_matrix
-from agents.scripted.grasp_pose import (
-    SWAP_FINGERS,
-    falls_open,
-    grasp_rotation,
-    grasp_target,
-    is_lid,
-    is_vertical_hinge,
-    lift_pose,
-    part_kind,
-    quarter_turn,
-)
+from agents.scripted.grasp_pose import SWAP_FINGERS, quarter_turn
 from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
 from agents.scripted.panda_kinematics import base_in_world, pose_matrix
+from agents.scripted.part_strategies import Lid, PartStrategy, strategy_for
 from agents.scripted.phases import grasp, pull, release
 from agents.scripted.phases.base import (
     GRIPPER_CLOSE,
@@ -87,13 +80,11 @@ class _Reach(OpenerPhase):
 
     @staticmethod
     def along_approach(ctx: OpenerContext, est: JointAxisEstimate, depth: float) -> tuple[np.ndarray, float]:
-        """The grasp point (a lid's front lip) moved ``depth`` m along the approach axis (negative:
-        outside the part), with the open gripper's action."""
-        cfg, choice = ctx.cfg, ctx.grasp
+        """The point the grasp's strategy grips (a lid's front lip) moved ``depth`` m along the approach
+        axis (negative: outside the part), with the gripper's action for its approach gap."""
+        choice, grip = ctx.grasp, ctx.grip(est)
         assert choice.target_r is not None
-        point = grasp_target(est, cfg) if choice.lid else est.grasp_point
-        return (point + choice.target_r[:, 2] * depth,
-                gripper_action(cfg.lid.gap if choice.lid else cfg.approach.gap))
+        return grip.grasp_target(est) + choice.target_r[:, 2] * depth, gripper_action(grip.gap)
 
     def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
         """The phase after the move ended (``ctx.move.reach_why`` says how)."""
@@ -127,14 +118,15 @@ class Approach(_Reach):
 
 class _Lift:
     """The lift from below's goal: the closed fingertips, pointing at the hinge and steeply down
-    (:func:`~agents.scripted.grasp_pose.lift_pose`); the plain grasp's goal when the grasp point lies
-    on the hinge line."""
+    (:meth:`~agents.scripted.part_strategies.Lid.lift_pose`: once a lid's lip proved wider than the
+    open fingers, every grasp of the episode lifts, whatever a later look shows); the plain grasp's
+    goal when the grasp point lies on the hinge line."""
 
     under = False
 
     def lift_goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float] | None:
         assert ctx.now is not None
-        lift = lift_pose(est, ctx.now.r, ctx.cfg, under=self.under)
+        lift = Lid(ctx.cfg).lift_pose(est, ctx.now.r, under=self.under)
         if lift is None:
             return None
         goal, ctx.grasp.target_r = lift
@@ -166,25 +158,27 @@ class LiftSlideUnder(_Lift, Approach):
 
 def choose_grasp(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
                  arm_qpos: np.ndarray | None) -> None:
-    """Choose the grasp's TCP rotation for ``est`` (a new grasp when none is chosen): across the
-    handle, the finger order nearer the hand's rotation unless the rehearsal prefers the other, turned
-    a quarter or half turn as recoveries asked."""
+    """Choose the grasp for ``est`` (a new grasp when none is chosen): its part-kind strategy
+    (:func:`~agents.scripted.part_strategies.strategy_for`, kept in ``ctx.grasp.strategy``) and the TCP
+    rotation it gives, across the handle, the finger order nearer the hand's rotation unless the
+    rehearsal prefers the other, turned a quarter or half turn as recoveries asked."""
     cfg, choice = ctx.cfg, ctx.grasp
     if choice.target_r is None:  # a new grasp (not a new choice for this one)
         choice.swap_this_grasp, choice.other_fingers = choice.other_fingers, False
         choice.pregrasp_steps = 1
-    target = grasp_rotation(est, r, cfg, robot_side(ctx, est, p, r, arm_qpos))
+    side = robot_side(ctx, est, p, r, arm_qpos)
+    kind = strategy_for(est, cfg, side)
+    target = kind.grasp_rotation(est, r, side)
     if choice.quarter:
         target = quarter_turn(target, r)
-    if cfg.grasp.rehearse_fingers and arm_qpos is not None and not is_lid(est, cfg):
-        target = rehearsed_fingers(ctx, est, p, r, arm_qpos, target)
+    if cfg.grasp.rehearse_fingers and arm_qpos is not None and kind.rehearses:
+        target = rehearsed_fingers(ctx, kind, est, p, r, arm_qpos, target)
     if choice.swap_this_grasp:
         target = target @ SWAP_FINGERS
     choice.target_r = target
     choice.target_for = np.array(est.grasp_point, dtype=np.float64)
     choice.looks = [choice.target_for.copy()]
-    choice.kind_for, choice.kinds = part_kind(est, cfg), []
-    choice.lid = choice.kind_for == "lid"
+    choice.strategy, choice.kinds = kind, []
 
 
 def robot_side(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
@@ -219,50 +213,54 @@ def grasp_point_moved(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
 
 
 def part_kind_changed(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
-    """Whether, with ``approach.rechoose_part_kind``, ``est`` shows another
-    :func:`~agents.scripted.grasp_pose.part_kind` than the estimate the grasp orientation was chosen
-    for, on each of the last ``approach.rechoose_looks`` looks (a first look can tilt a door's hinge
-    into a lid's)."""
+    """Whether, with ``approach.rechoose_part_kind``, ``est`` shows a part grasped otherwise (another
+    ``grasp_kind`` of :func:`~agents.scripted.part_strategies.strategy_for`) than the grasp's strategy,
+    on each of the last ``approach.rechoose_looks`` looks (a first look can tilt a door's hinge into a
+    lid's)."""
     cfg, choice = ctx.cfg, ctx.grasp
-    if not cfg.approach.rechoose_part_kind or choice.kind_for is None:
+    if not cfg.approach.rechoose_part_kind or choice.strategy is None:
         return False
     key = np.concatenate([est.grasp_point, est.direction]).astype(np.float64)
     if choice.kind_key is None or float(np.abs(key - choice.kind_key).max()) > 1e-9:  # a new look
         choice.kind_key = key
-        choice.kinds = [*choice.kinds, part_kind(est, cfg)][-cfg.approach.rechoose_looks:]
-    return len(choice.kinds) >= cfg.approach.rechoose_looks and all(
-        k != choice.kind_for for k in choice.kinds)
+        choice.kinds = [*choice.kinds, strategy_for(est, cfg).grasp_kind][-cfg.approach.rechoose_looks:]
+    chosen = choice.strategy.grasp_kind
+    return len(choice.kinds) >= cfg.approach.rechoose_looks and all(k != chosen for k in choice.kinds)
 
 
 def falling_on_its_own(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
-    """Whether, before its grasp, a part that :func:`~agents.scripted.grasp_pose.falls_open` is seen
-    falling open: at least ``falling_door.settle_above`` open and risen by ``falling_door.progress``
-    over the last ``falling_door.window`` steps (``falling_door.watch`` and ``done_above`` > 0; never
-    while lifting a lid)."""
+    """Whether, before its grasp, a part that ``est`` shows is a
+    :class:`~agents.scripted.part_strategies.FallingDoor` is seen falling open: at least
+    ``falling_door.settle_above`` open and risen by ``falling_door.progress`` over the last
+    ``falling_door.window`` steps (``falling_door.watch`` and ``done_above`` > 0; never while lifting a
+    lid)."""
     cfg = ctx.cfg.falling_door
-    if not cfg.watch or cfg.done_above <= 0.0 or ctx.lift or not falls_open(est, ctx.cfg):
+    if not cfg.watch or cfg.done_above <= 0.0 or ctx.lift or not strategy_for(est, ctx.cfg).falls_open:
         ctx.watch = []
         return False
     ctx.watch.append(float(est.state))
     return ctx.watch[-1] >= cfg.settle_above and release.risen(ctx, ctx.watch)
 
 
-def rehearse_grasp(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
-                   arm_qpos: np.ndarray, rotation: np.ndarray) -> Rehearsal:
-    """Grasp and pull with TCP ``rotation`` (3, 3) rehearsed on the arm's kinematic model."""
+def rehearse_grasp(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimate, p: np.ndarray,
+                   r: np.ndarray, arm_qpos: np.ndarray, rotation: np.ndarray) -> Rehearsal:
+    """Grasp and pull with TCP ``rotation`` (3, 3) rehearsed on the arm's kinematic model, the pull
+    to ``kind``'s target, the hand turning as ``kind`` turns it."""
     cfg = ctx.cfg
     approach = rotation[:, 2]
     point = est.grasp_point
     grasp_at = point + approach * cfg.approach.grasp_depth
     u = unit(est.direction)
     path: list[tuple[np.ndarray, np.ndarray]] = []
-    if est.joint_type == "revolute":
-        follow = 1.0 if is_vertical_hinge(est, cfg) else cfg.pull.revolute.wrist_follow
-        for delta in np.arange(0.05, max(cfg.pull.revolute.target - float(est.state), 0.0) + 1e-9, 0.05):
+    revolute = est.joint_type == "revolute"
+    target = kind.pull_target(revolute)
+    if revolute:
+        follow = kind.hand_turn(est, lifting=False)
+        for delta in np.arange(0.05, max(target - float(est.state), 0.0) + 1e-9, 0.05):
             path.append((est.pivot + axis_angle_matrix(u, delta) @ (grasp_at - est.pivot),
                          axis_angle_matrix(u, follow * delta) @ rotation))
     else:
-        for delta in np.arange(0.01, max(cfg.pull.prismatic.target - float(est.state), 0.0) + 1e-9, 0.01):
+        for delta in np.arange(0.01, max(target - float(est.state), 0.0) + 1e-9, 0.01):
             path.append((grasp_at + u * delta, rotation))
     pregrasp_at = point - approach * cfg.approach.pregrasp_offset
     move = cfg.move
@@ -275,8 +273,8 @@ def rehearse_grasp(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r:
                     pull_tolerance_rad=cfg.grasp.rehearse_track_rad)
 
 
-def rehearsed_fingers(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
-                      arm_qpos: np.ndarray, nearer: np.ndarray) -> np.ndarray:
+def rehearsed_fingers(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimate, p: np.ndarray,
+                      r: np.ndarray, arm_qpos: np.ndarray, nearer: np.ndarray) -> np.ndarray:
     """``nearer`` (3, 3), or the same approach with the fingers swapped if the rehearsal says the arm
     reaches and pulls clearly better that way (``grasp.rehearse_fingers``)."""
     cfg = ctx.cfg
@@ -286,8 +284,8 @@ def rehearsed_fingers(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray,
         return (x.grasp_error_m <= 2 * cfg.move.pos_tolerance
                 and x.grasp_error_rad <= 2 * cfg.move.rot_tolerance)
 
-    a = rehearse_grasp(ctx, est, p, r, arm_qpos, nearer)
-    b = rehearse_grasp(ctx, est, p, r, arm_qpos, other)
+    a = rehearse_grasp(ctx, kind, est, p, r, arm_qpos, nearer)
+    b = rehearse_grasp(ctx, kind, est, p, r, arm_qpos, other)
     ctx.rehearsals = (a, b)
     if reaches(b) and b.pull_share >= 1.0 and (
             not reaches(a) or a.pull_share <= 1.0 - cfg.grasp.rehearse_margin):
