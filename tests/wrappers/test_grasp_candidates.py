@@ -5,12 +5,17 @@ double door, nothing, or stray points in front of it. World frame, metres."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from capt_common.typed_yaml import ConfigError
 from capt_env.wrappers.grasp_candidates import GraspCandidateConfig, clusters, find_grasp_candidates
 from capt_env.wrappers.moving_part_geometry import handle_point
+from capt_env.wrappers.refiners.draft import network_draft
+from capt_env.wrappers.refiners.handle import Handle
+from perception.inference import ArticulationEstimate, JointEstimate
 
 FACE_X = -0.2
 OUT = np.array([-1.0, 0.0, 0.0])
@@ -132,6 +137,18 @@ def test_two_bars_of_a_double_door_are_two_candidates_never_their_middle() -> No
         assert abs(found_at[2] - bar[2]) < 0.02
     assert all(abs(g.point[1]) > 0.05 for g in found[:2])  # nothing between the two handles
     assert abs(handle_point(cloud, door)[1]) < 0.02  # the old single centroid falls between them
+
+
+def test_the_handle_refiner_grasps_one_bar_of_a_double_door() -> None:
+    rng = np.random.default_rng(4)
+    left, right = _at(0.03, -0.08, 0.2), _at(0.03, 0.08, 0.2)
+    cloud, door = _scene(rng, _bar(rng, left, Z), _bar(rng, right, Z))
+    labels = np.r_[np.ones(len(door), int), np.zeros(len(cloud) - len(door), int)]
+    hinge = JointEstimate(0, "revolute", Z, np.array([FACE_X, -0.2, 0.2]), 0.0, 0.9)
+    draft = network_draft(ArticulationEstimate(labels, (hinge,), 0.0), cloud, 0,
+                          SimpleNamespace(joint_child_parts=(1,), joint_types=("revolute",)))
+    assert Handle().refine(draft) and draft.from_handle and draft.grasp is not None
+    assert min(np.linalg.norm(draft.grasp - left), np.linalg.norm(draft.grasp - right)) < 0.02
 
 
 def test_a_bare_panel_offers_only_its_free_edge() -> None:

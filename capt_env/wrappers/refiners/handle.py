@@ -4,11 +4,15 @@ Geometric reason: a handle is the part of a door, drawer front or lid that stand
 its flat face, 1.2-8 cm (``min_standoff``..``max_standoff``), within the face's extent; the network's
 fallback, the part's far edge, is a strip along the whole edge. The search runs on the draft's
 ``handle_cloud`` (all object points: a segmentation may miss thin handle points) against the
-``panel``'s plane and extent. A bar is centred across its thickness too (the cameras see one side
-of it), except on a part swinging about a horizontal hinge (an oven door, a lid): measured, that
-moved an oven's grasp point off its bar.
+``panel``'s plane and extent, and takes the best-scored bar or knob among the grasp candidates
+(:func:`~capt_env.wrappers.grasp_candidates.find_grasp_candidates`): points standing off the face are
+split into linked clusters, so two handles of a double door are two candidates, not one centroid
+between them, and stray points too few to be a handle, or a slab wider than a hand, are dropped. A
+bar is centred across its thickness too (the cameras see one side of it), except on a part swinging
+about a horizontal hinge (an oven door, a lid): measured, that moved an oven's grasp point off its bar.
 Must not fire: when a refiner already found the handle (``stacked_parts``), the part is not flat (or
-a prismatic part's face does not face along its slide), or too few points stand off the face.
+a prismatic part's face does not face along its slide), or no cluster of enough points standing off
+the face is a bar or knob no wider than ``max_width`` (the face's edge is the draft's own fallback).
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from capt_common.typed_yaml import require
-from capt_env.wrappers.moving_part_geometry import handle_point
+from capt_env.wrappers.grasp_candidates import GraspCandidateConfig, find_grasp_candidates
 from capt_env.wrappers.refiners.draft import Draft
 
 
@@ -52,10 +56,12 @@ class Handle:
             return False
         c = self.config
         across = draft.joint_type == "prismatic" or abs(float(draft.direction[2])) >= c.vertical_hinge_min_z
-        grasp = handle_point(draft.handle_cloud, draft.panel, min_standoff=c.min_standoff,
-                             max_standoff=c.max_standoff, margin=c.margin,
-                             min_points=draft.handle_min_points, plane=draft.plane, centre_across=across)
-        if grasp is None:
+        found = find_grasp_candidates(
+            draft.handle_cloud, draft.panel, plane=draft.plane, centre_across=across,
+            config=GraspCandidateConfig(min_standoff=c.min_standoff, max_standoff=c.max_standoff,
+                                        margin=c.margin, min_points=draft.handle_min_points))
+        handles = [g for g in found if g.kind in ("bar", "knob")]
+        if not handles:
             return False
-        draft.grasp, draft.from_handle = grasp, True
+        draft.grasp, draft.from_handle = handles[0].point, True
         return True
