@@ -31,15 +31,25 @@ def main() -> None:
     parser.add_argument("--max-steps", type=int, default=200)
     parser.add_argument("--every", type=int, default=5)
     parser.add_argument("--json", default=None)
+    parser.add_argument("--perception", default="oracle", choices=["oracle", "capt", "capt_raw"],
+                        help="perception source; capt/capt_raw use the object's shipped model (`like`)")
+    parser.add_argument("--every-k-steps", type=int, default=5, help="perception every k control steps")
     args = parser.parse_args()
     if args.seed >= 10000:
         raise SystemExit("seeds from 10000 are held out for reporting; trace development seeds")
     task = task_overrides(args.task)
     targets = {t.label: t for t in load_objects_yaml(args.objects)}
-    if args.name in targets:
-        env = make_env(None, {"source": "oracle"}, task=target_task(targets[args.name], task))
+    wrapper: dict = {"source": args.perception, "every_k_steps": args.every_k_steps}
+    target = targets.get(args.name)
+    if args.perception != "oracle":
+        from perception.checkpoints import default_checkpoint
+
+        wrapper["checkpoint"] = str(default_checkpoint(target.model_category() if target else args.name))
+    obs_mode = "state" if args.perception == "oracle" else "pointcloud"
+    if target is not None:
+        env = make_env(None, wrapper, task=target_task(target, task), obs_mode=obs_mode)
     else:
-        env = make_env(args.name, {"source": "oracle"}, task=task)
+        env = make_env(args.name, wrapper, task=task, obs_mode=obs_mode)
     opener = ScriptedOpener()
     obs, info = env.reset(seed=args.seed)
     opener.reset()

@@ -109,12 +109,19 @@ def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standof
                         in_plane.max(axis=0) + margin, min_standoff, max_standoff)
     if int(keep.sum()) < min_points:
         return None
-    # the handle is what stands out furthest; surface bumps and noise sit just above min_standoff
-    standoff = (object_points - plane.centre) @ plane.outward
-    keep &= standoff >= 0.5 * float(np.quantile(standoff[keep], 0.9))
+    keep[keep] = outer_layer(object_points[keep], plane)
     if int(keep.sum()) < min_points:
         return None
     return bar_centre(object_points[keep], plane.outward if centre_across else None)
+
+
+def outer_layer(handle: np.ndarray, plane: PartPlane) -> np.ndarray:
+    """(M,) mask of a handle's points (M, 3) standing at least half as far out of ``plane`` as its
+    outermost ones (the 0.9 quantile): the bar a hand closes on. Surface bumps and noise sit just
+    above the search band's floor, and the posts that hold a bar off the face run from the face to
+    the bar: their points would pull a centroid towards the face, behind the bar."""
+    standoff = (handle - plane.centre) @ plane.outward
+    return standoff >= 0.5 * float(np.quantile(standoff, 0.9))
 
 
 def standing_off(points: np.ndarray, plane: PartPlane, lo: np.ndarray, hi: np.ndarray,

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from capt_env.wrappers.moving_part_geometry import PartPlane, bar_centre, part_plane, standing_off
+from capt_env.wrappers.moving_part_geometry import PartPlane, bar_centre, outer_layer, part_plane, standing_off
 
 _UP = np.array([0.0, 0.0, 1.0])
 
@@ -56,7 +56,8 @@ def kth_handle_from_bottom(object_points: np.ndarray, front_points: np.ndarray, 
     :func:`handle_groups`), world frame, metres; None when fewer than ``k + 1`` handles are seen.
     The centre is the middle of the handle's extent along its main direction (a bar's visible
     points are denser at one end) and across it in the front's plane (a camera sees one side of a
-    bar). ``min_points``: the fewest points of a handle."""
+    bar), over the handle's outer layer only (:func:`~capt_env.wrappers.moving_part_geometry.outer_layer`:
+    the bar, not the posts holding it off the front). ``min_points``: the fewest points of a handle."""
     if k < 0:
         raise ValueError(f"k must be >= 0, got {k}")
     plane = plane or part_plane(object_points, front_points)
@@ -65,4 +66,5 @@ def kth_handle_from_bottom(object_points: np.ndarray, front_points: np.ndarray, 
     groups = handle_groups(object_points, front_points, plane=plane, min_points=min_points)
     if len(groups) <= k:
         return None
-    return bar_centre(groups[k], plane.outward)
+    handle = groups[k]
+    return bar_centre(handle[outer_layer(handle, plane)], plane.outward)

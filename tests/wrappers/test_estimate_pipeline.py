@@ -1,7 +1,8 @@
 """The estimate pipeline on recorded looks: ``capt`` gives what it gave before the pipeline was split
 into refiners, and with no refiners it is ``capt_raw``, the network's own estimate.
 
-``tests/data/capt_estimates.npz`` (``scripts/record_capt_estimates.py``, before the refactor): per
+``tests/data/capt_estimates.npz`` (``scripts/record_capt_estimates.py``, first recorded before the
+refactor; re-recorded only when a refiner's output changes on purpose, which the commit says): per
 perception call of the ``capt`` source with the shipped checkpoints (cabinet door, drawer cabinet,
 laptop; seeds 0 and 2; at reset and one step later), the isolated points, the network's input and
 output, and the estimate. The network is replayed, so no rendering and no torch model run here.

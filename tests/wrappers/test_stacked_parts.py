@@ -60,3 +60,21 @@ def test_a_drawer_front_faces_along_the_slide_its_bottom_does_not() -> None:
     assert faces_along(front, slide) and faces_along(front, -slide)  # the line, either sign
     assert not faces_along(bottom, slide)
     assert not faces_along(None, slide)
+
+
+def test_a_bar_held_off_the_front_by_posts_is_gripped_at_the_bar_not_the_posts() -> None:
+    """A drawer's bar 4 cm out on two posts: the posts' points run from the front to the bar, and a
+    centroid over them would sit ~1 cm behind the bar, where closing fingers find nothing."""
+    rng = np.random.default_rng(4)
+    cloud, front = _cabinet(rng, handles=())
+    bar = np.column_stack([rng.normal(-0.04, 0.002, 60), rng.uniform(-0.06, 0.06, 60),
+                           rng.normal(0.21, 0.003, 60)])
+    posts = [np.column_stack([rng.uniform(-0.04, -0.012, 40), rng.normal(y, 0.003, 40),
+                              rng.normal(0.21, 0.003, 40)]) for y in (-0.05, 0.05)]
+    cloud = np.concatenate([cloud, bar, *posts])
+    h = kth_handle_from_bottom(cloud, front, 0)
+    assert h is not None
+    handle = np.concatenate([bar, *posts])
+    assert h[0] < float(handle[:, 0].mean()) - 0.003  # out towards the bar, away from the posts' centroid
+    assert h[0] == pytest.approx(-0.04, abs=0.006)
+    np.testing.assert_allclose(h[1:], [0.0, 0.21], atol=0.01)
