@@ -901,3 +901,26 @@ def test_a_closed_door_the_view_reads_open_is_pulled_from_closed() -> None:
     assert opener.ctx.pull.grasp_state == 0.0
     start_pull(opener.ctx, start, np.eye(3), est, "again")
     assert opener.ctx.pull.grasp_state == pytest.approx(0.9)
+
+
+def test_a_look_mid_pull_that_moves_the_pivot_neither_moves_the_arc_nor_reads_the_part_open() -> None:
+    """Half-way up, a look that segments a lid as the base puts its pivot 25 cm off: the pull keeps the
+    arc it began with (the hand's state about that pivot, the same commanded step), not one that reads
+    the lid at its target and lets go."""
+    est = _closed_laptop()
+    start = est.grasp_point - np.array([0.0, 0.0, 0.01])
+    now = est.pivot + axis_angle_matrix(est.direction, 0.5) @ (start - est.pivot)
+
+    def pulled(seen_pivot: np.ndarray) -> tuple[ScriptedOpener, np.ndarray]:
+        opener = ScriptedOpener(_cfg(move__max_step_m=1.0))
+        opener.ctx.grasp.lid = opener.ctx.lift = True
+        opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))
+        seen = JointAxisEstimate("revolute", est.direction, seen_pivot, 0.5, now)
+        return opener, _pull_step(opener, seen, now, np.eye(3), finger_gap=0.0)
+
+    same, action = pulled(est.pivot)
+    moved, moved_action = pulled(est.pivot + np.array([0.25, 0.0, 0.05]))
+    assert moved.phase == Phase.PULL
+    assert moved.ctx.pull.history[-1] == pytest.approx(0.5, abs=1e-6)
+    np.testing.assert_allclose(moved_action, action, atol=1e-9)
+    assert same.ctx.pull.history[-1] == pytest.approx(0.5, abs=1e-6)

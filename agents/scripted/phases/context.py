@@ -67,6 +67,9 @@ class PullTrack:
     """TCP rotation (3, 3) there."""
     grasp_state: float = 0.0
     """The part's state (rad or m) there: the estimate's at the grasp, then the hand's own measure."""
+    grasp_pivot: np.ndarray | None = None
+    """The estimated pivot (3,) m when the pull began: the arc's centre until the part's own motion
+    measures one (``pull.arc_fit``, ``pull.motion_axis``)."""
     grasp_u: np.ndarray | None = None
     """Unit axis (3,) the part opened along when the pull began (a re-estimate that flips it is turned
     back)."""

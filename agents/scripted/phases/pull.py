@@ -39,6 +39,7 @@ def start_pull(ctx: OpenerContext, p: np.ndarray, r: np.ndarray, est: JointAxisE
     track.grasp_p, track.grasp_r = p.copy(), r.copy()
     track.grasp_state = 0.0 if first else est.state
     track.grasp_u = unit(est.direction)
+    track.grasp_pivot = np.asarray(est.pivot, dtype=np.float64).copy()
     track.falls = strategy_for(est, ctx.cfg).falls_open
     track.history = []
     track.pulled = [p.copy()]
@@ -69,10 +70,15 @@ class Pull(OpenerPhase):
             u = motion_axis(ctx, est, u, p, r, finger_gap, revolute)
         # while the hand holds the part, its own travel along the estimated arc or line measures the
         # part's state every step; the perceived state is noisier and only as fresh as the last estimate
+        # one arc per pull: the pivot the pull began with, replaced only by one the part's own motion
+        # measures (arc_fit, motion_axis). A later look's pivot would re-read the whole path's angle
+        # and move the arc's goal with it: a look that segments the lid as the base, half-way open,
+        # puts the pivot 25 cm off and reads the lid at its target
         if ctx.axis.motion is not None:
             pivot = ctx.axis.motion.pivot
         else:
-            pivot = hinge_pivot(ctx, u, est.pivot, p, finger_gap) if revolute else est.pivot
+            assert track.grasp_pivot is not None
+            pivot = hinge_pivot(ctx, u, track.grasp_pivot, p, finger_gap) if revolute else track.grasp_pivot
         state = hand_state(ctx, u, pivot, p, revolute)
         track.history.append(state)
         track.pulled.append(p.copy())
@@ -255,7 +261,7 @@ def motion_axis(ctx: OpenerContext, est: JointAxisEstimate, u: np.ndarray, p: np
     if holding and (not axis.part_path or np.linalg.norm(gp - axis.part_path[-1]) > 1e-3):
         axis.part_path.append(gp.copy())  # a new estimate (they repeat between looks)
     if axis.motion is None and holding:
-        pivot = track.hinge_fit if track.hinge_fit is not None else est.pivot
+        pivot = track.hinge_fit if track.hinge_fit is not None else track.grasp_pivot
         fit = fit_motion_axis(np.asarray(axis.part_path), u, pivot, revolute, cfg.min_travel, cfg.min_angle,
                               cfg.max_rms, cfg.max_turn, cfg.max_ratio, cfg.hinge_points if revolute else 3)
         if fit is not None:
