@@ -136,11 +136,12 @@ class GraspConfig:
     rehearse_fingers: bool = True
     """Rehearse both finger orders of a grasp (not a lid's) on the Panda's kinematic model
     (:mod:`agents.scripted.grasp_rehearsal`) and take the one farther from the hand's rotation only if
-    it reaches the grasp and follows the whole pull while the nearer one does not: one order can leave a
-    wrist joint at its limit."""
+    it reaches the grasp and follows the whole pull while the nearer one does not, or clearly more of
+    it: one order can leave a wrist joint at its limit."""
     rehearse_margin: float = 0.2
-    """... the nearer order is given up only if it falls behind before ``1 - margin`` of the pull path
-    (a share in (0, 1]): when both fall behind late, the model cannot tell them apart."""
+    """... the nearer order is given up only if the other follows at least this share of the pull path
+    (in (0, 1]) more than it: when both fall behind at about the same place, the model cannot tell
+    them apart."""
     rehearse_track_m: float = 0.02
     """A rehearsed TCP farther than this (m) from the pull path has fallen behind."""
     rehearse_track_rad: float = 0.25

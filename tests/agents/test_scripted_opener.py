@@ -945,3 +945,41 @@ def test_a_sliding_panel_from_a_real_file_opens_with_oracle_perception() -> None
     finally:
         env.close()
     assert result.success, result
+
+
+def test_a_lever_door_grasp_whose_wrist_roll_pins_early_takes_the_finger_order_that_follows_further() -> None:
+    # a door on a vertical hinge with a lever handle (Meta-World's lever door), grasped after a quarter
+    # turn (the fingers close across the lever, which runs along the door's radius). The hand is
+    # pitched 45 deg down, so turning it with the door is half a roll about its approach, which only
+    # joint 7 gives: in the order nearer the hand joint 7 starts near its 2.90 limit and the hand's roll
+    # falls behind the door a third of the way (the lever then twists out of the fingers); the other
+    # order starts half a turn away from that limit and follows 85% of the pull. Neither follows the
+    # whole pull, and the one that follows clearly further is taken (grasp.rehearse_margin)
+    base = np.array([-0.615, 0.0, 0.0])
+    q = np.array([0.55, 0.54, -0.75, -2.01, -0.61, 3.1, 1.98])
+    tcp = tcp_pose(q)  # the base at the world origin
+    door = JointAxisEstimate("revolute", np.array([0.0, 0.0, -1.0]), np.array([0.318, 0.177, 0.151]) - base,
+                             0.0, np.array([0.128, -0.144, 0.151]) - base)
+    pose = np.concatenate([tcp[:3, 3], Rotation.from_matrix(tcp[:3, :3]).as_quat(scalar_first=True)])
+    plain = ScriptedOpener(_cfg(grasp__rehearse_fingers=False))
+    plain.ctx.grasp.quarter = True
+    plain.act_on(door, pose, finger_gap=0.06, arm_qpos=q)
+    rehearsed = ScriptedOpener(_cfg())
+    rehearsed.ctx.grasp.quarter = True
+    rehearsed.act_on(door, pose, finger_gap=0.06, arm_qpos=q)
+    nearer, other = rehearsed.rehearsals
+    assert nearer.pull_share < 0.5 and other.pull_share < 1.0
+    assert other.pull_share - nearer.pull_share >= ScriptedOpenerConfig().grasp.rehearse_margin
+    # the same approach, the fingers the other way round
+    chosen, near = rehearsed.ctx.grasp.target_r, plain.ctx.grasp.target_r
+    np.testing.assert_allclose(chosen[:, 2], near[:, 2], atol=1e-9)
+    np.testing.assert_allclose(chosen[:, 1], -near[:, 1], atol=1e-9)
+    # before the quarter turn the nearer order follows as far as this one and the other reaches nothing:
+    # the nearer is kept
+    first = ScriptedOpener(_cfg())
+    first.act_on(door, pose, finger_gap=0.06, arm_qpos=q)
+    nearer, other = first.rehearsals
+    assert nearer.pull_share > 0.8 and other.pull_share == 0.0
+    unrehearsed = ScriptedOpener(_cfg(grasp__rehearse_fingers=False))
+    unrehearsed.act_on(door, pose, finger_gap=0.06, arm_qpos=q)
+    np.testing.assert_allclose(first.ctx.grasp.target_r, unrehearsed.ctx.grasp.target_r, atol=1e-9)

@@ -276,7 +276,14 @@ def rehearse_grasp(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimat
 def rehearsed_fingers(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimate, p: np.ndarray,
                       r: np.ndarray, arm_qpos: np.ndarray, nearer: np.ndarray) -> np.ndarray:
     """``nearer`` (3, 3), or the same approach with the fingers swapped if the rehearsal says the arm
-    reaches and pulls clearly better that way (``grasp.rehearse_fingers``)."""
+    reaches and pulls clearly better that way (``grasp.rehearse_fingers``): the other order reaches the
+    grasp and follows either the whole pull while the nearer one does not, or at least
+    ``grasp.rehearse_margin`` more of it. The second case is a hand pinned by a wrist joint early in
+    both orders' pulls but at different places: about a vertical hinge, a grasp pitched down turns
+    the hand partly about its approach axis, which only joint 7 gives; an order that starts with
+    joint 7 near its limit (after a quarter turn, say) lets the hand's roll lag the door within a few
+    tenths of a radian, and a lever held across the fingers twists out of them, while the other order
+    starts half a turn away from that limit and follows most of the pull."""
     cfg = ctx.cfg
     other = nearer @ SWAP_FINGERS
 
@@ -287,7 +294,7 @@ def rehearsed_fingers(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEsti
     a = rehearse_grasp(ctx, kind, est, p, r, arm_qpos, nearer)
     b = rehearse_grasp(ctx, kind, est, p, r, arm_qpos, other)
     ctx.rehearsals = (a, b)
-    if reaches(b) and b.pull_share >= 1.0 and (
-            not reaches(a) or a.pull_share <= 1.0 - cfg.grasp.rehearse_margin):
+    if reaches(b) and ((b.pull_share >= 1.0 and not reaches(a))
+                       or b.pull_share - a.pull_share >= cfg.grasp.rehearse_margin):
         return other
     return nearer
