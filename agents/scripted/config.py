@@ -275,6 +275,17 @@ class PullConfig:
     slip_steps: int = 8
     """... for this many steps (longer than a perception period: one bad estimate, e.g. of a handle the
     hand now hides, is not a slip) with its fingers closed on nothing (a gap means they still hold)."""
+    frozen_joints: float = 0.002
+    """A pull step after which no arm joint moved more than this (rad) froze the arm: the
+    ``pd_ee_delta_pose`` controller's IK (100 CLIK iterations from the joints' angles) does not converge
+    on a full step towards a goal near the edge of the arm's reach (the elbow near straight, where a
+    step of the TCP is a large step of the joints) and then holds the arm where it is, step after step,
+    which reads as a stall. 0: off."""
+    step_shrink: float = 0.5
+    """... the pull's later steps are this share of the commanded ones (again after each frozen step,
+    kept for the rest of the pull) ..."""
+    min_step_share: float = 0.25
+    """... down to this share: half a step converges where the full one does not."""
     revolute: RevolutePullConfig = field(default_factory=RevolutePullConfig)
     prismatic: PrismaticPullConfig = field(default_factory=PrismaticPullConfig)
     arc_fit: ArcFitConfig = field(default_factory=ArcFitConfig)
@@ -282,6 +293,10 @@ class PullConfig:
 
     def validate(self) -> None:
         _positive(self, "slip_distance", where="pull.")
+        _non_negative(self, "frozen_joints", where="pull.", note=" rad (0: off)")
+        require(0.0 < self.min_step_share <= 1.0 and 0.0 < self.step_shrink <= 1.0,
+                f"pull.step_shrink and pull.min_step_share must be in (0, 1], got {self.step_shrink}, "
+                f"{self.min_step_share}")
         _at_least_one(self, "stall_steps", "slip_steps", where="pull.")
         for sub in (self.revolute, self.prismatic, self.arc_fit, self.motion_axis):
             sub.validate()

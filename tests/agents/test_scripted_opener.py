@@ -983,3 +983,41 @@ def test_a_lever_door_grasp_whose_wrist_roll_pins_early_takes_the_finger_order_t
     unrehearsed = ScriptedOpener(_cfg(grasp__rehearse_fingers=False))
     unrehearsed.act_on(door, pose, finger_gap=0.06, arm_qpos=q)
     np.testing.assert_allclose(first.ctx.grasp.target_r, unrehearsed.ctx.grasp.target_r, atol=1e-9)
+
+
+def test_a_pull_whose_arm_froze_near_the_edge_of_its_reach_shortens_its_steps() -> None:
+    # a door swung far round leads the hand to where the elbow is near straight: the controller's IK
+    # does not converge on a full step there and holds the arm still (every joint where it was), which
+    # would read as a stall. Each such step halves the pull's later steps, down to a quarter, for the
+    # rest of the pull; an arm whose joints move keeps full steps
+    door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([0.3, 0.3, 0.2]), 0.0,
+                             np.array([0.3, 0.0, 0.2]))
+    p = np.array([0.3, 0.0, 0.2])
+    q = np.array([0.8, 1.0, -0.4, -1.0, -0.2, 1.4, 1.7])
+
+    def actions(frozen: bool) -> list[np.ndarray]:
+        opener = ScriptedOpener(_cfg())
+        opener.enter(start_pull(opener.ctx, p, np.eye(3), door, "closed"))
+        steps = []
+        for k in range(5):
+            joints = q if frozen else q + 0.01 * k
+            steps.append(_pull_step(opener, door, p, np.eye(3), finger_gap=0.03, arm_qpos=joints)[:6])
+        return steps
+
+    moving, frozen = actions(False), actions(True)
+    assert np.abs(moving[0]).max() > 0.1
+    for k, share in enumerate([1.0, 0.5, 0.25, 0.25, 0.25]):
+        np.testing.assert_allclose(frozen[k], share * moving[k], atol=1e-6)
+    # kept for the rest of the pull once the joints move again; a new pull starts with full steps
+    opener = ScriptedOpener(_cfg())
+    opener.enter(start_pull(opener.ctx, p, np.eye(3), door, "closed"))
+    for joints in (q, q, q + 0.1):
+        _pull_step(opener, door, p, np.eye(3), finger_gap=0.03, arm_qpos=joints)
+    assert opener.ctx.pull.step_share == 0.5
+    start_pull(opener.ctx, p, np.eye(3), door, "closed")
+    assert opener.ctx.pull.step_share == 1.0
+    off = ScriptedOpener(_cfg(pull__frozen_joints=0.0))
+    off.enter(start_pull(off.ctx, p, np.eye(3), door, "closed"))
+    for joints in (q, q, q):
+        _pull_step(off, door, p, np.eye(3), finger_gap=0.03, arm_qpos=joints)
+    assert off.ctx.pull.step_share == 1.0

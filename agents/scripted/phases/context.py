@@ -83,6 +83,10 @@ class PullTrack:
     """The hinge pivot (3,) m fitted to the held path (``pull.arc_fit``), kept for the pull."""
     slip_count: int = 0
     """Steps running the hand has been off the grasp point with its fingers closed on nothing."""
+    step_share: float = 1.0
+    """The share of the commanded steps the pull moves by (``pull.step_shrink``)."""
+    last_q: np.ndarray | None = None
+    """The arm's joint angles (7,) rad at the last pull step."""
     falls: bool = False
     """The part falls open when let go: the estimate the pull began with shows a
     :class:`~agents.scripted.part_strategies.FallingDoor` (a door near level, its handle hidden by the

@@ -46,6 +46,7 @@ def start_pull(ctx: OpenerContext, p: np.ndarray, r: np.ndarray, est: JointAxisE
     track.held = [p.copy()]
     track.hinge_fit = None
     track.slip_count = 0
+    track.step_share, track.last_q = 1.0, None
     # a hand lifting from below holds with closed fingers; unknown gaps count as holding
     return Pull(why, grip="held" if ctx.lift else "none")
 
@@ -149,7 +150,24 @@ class Pull(OpenerPhase):
             return hold(GRIPPER_OPEN), reach.pregrasp(ctx, "slip")
         p_des, r_des = pull_pose(ctx, grip, est, u, pivot, state, revolute)
         action, _, _ = goto(ctx, p, r, p_des, r_des, GRIPPER_CLOSE)
+        action[:6] *= step_share(ctx, arm_qpos)
         return action, self
+
+
+def step_share(ctx: OpenerContext, arm_qpos: np.ndarray | None) -> float:
+    """The share of the commanded TCP step this pull step moves by: 1, shrunk by ``pull.step_shrink``
+    (down to ``pull.min_step_share``, kept for the rest of the pull) after each step that left every
+    arm joint within ``pull.frozen_joints`` rad of where it was (``arm_qpos`` (7,) rad; None: unknown).
+    A pull that leads the part near the edge of the arm's reach (a door swung far round, the elbow near
+    straight) asks for a step the controller's IK does not converge on, and the controller holds the
+    arm still, step after step; a shorter step converges."""
+    cfg, track = ctx.cfg.pull, ctx.pull
+    q = None if arm_qpos is None else np.asarray(arm_qpos, dtype=np.float64).reshape(-1)[:7]
+    if (cfg.frozen_joints > 0.0 and q is not None and track.last_q is not None
+            and float(np.abs(q - track.last_q).max()) < cfg.frozen_joints):
+        track.step_share = max(track.step_share * cfg.step_shrink, cfg.min_step_share)
+    track.last_q = q
+    return track.step_share
 
 
 def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u: np.ndarray,
