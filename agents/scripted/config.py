@@ -410,10 +410,15 @@ class LidConfig:
     slip_off_axis: bool = True
     """A lid's slip distance leaves out its component along the hinge: a lid has no handle, and its grasp
     point (the middle of the far edge's visible points) slides along the edge as the hand hides part of it."""
+    along_slack: float = 0.04
+    """Along the hinge the reach keeps the hand's own place within this (m) of the grasp point: any
+    point of a lid's lip is gripped alike, and the grasp point (the middle of the lip's visible points)
+    slides along it from look to look as the hand hides part of it; chased, the hand never settles."""
     lift: LidLiftConfig = field(default_factory=LidLiftConfig)
 
     def validate(self) -> None:
         _angle(self.max_tilt, "lid.max_tilt")
+        _non_negative(self, "along_slack", where="lid.", note=" m")
         require(0.0 < self.gap <= 0.08, f"lid.gap must be in (0, 0.08] m, got {self.gap}")
         _non_negative(self, "edge_offset", where="lid.", note=" m")
         _share(self, "wrist_follow", where="lid.")

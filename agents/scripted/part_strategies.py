@@ -101,6 +101,11 @@ class PartStrategy(ABC):
         """Finger gap while approaching (m): ``approach.gap``."""
         return self.cfg.approach.gap
 
+    def along_slack(self, est: JointAxisEstimate) -> float:
+        """How far (m) along the joint axis the reach may keep the hand's own place instead of the grasp
+        point's: 0, a handle is gripped where it is."""
+        return 0.0
+
     def grasp_target(self, est: JointAxisEstimate) -> np.ndarray:
         """World point (3,) the TCP grips: the grasp point (a handle's)."""
         return est.grasp_point
@@ -256,6 +261,10 @@ class Lid(Hinged):
         point."""
         frame = lid_frame(est) if is_lid(est, self.cfg) else None
         return est.grasp_point if frame is None else est.grasp_point + self.own.edge_offset * frame[0]
+
+    def along_slack(self, est: JointAxisEstimate) -> float:
+        """``lid.along_slack`` while ``est`` shows a lid (its grip is a lip along the hinge)."""
+        return self.own.along_slack if is_lid(est, self.cfg) else 0.0
 
     def lift_pose(self, est: JointAxisEstimate, current: np.ndarray,
                   under: bool) -> tuple[np.ndarray, np.ndarray] | None:

@@ -1021,3 +1021,24 @@ def test_a_pull_whose_arm_froze_near_the_edge_of_its_reach_shortens_its_steps() 
     for joints in (q, q, q):
         _pull_step(off, door, p, np.eye(3), finger_gap=0.03, arm_qpos=joints)
     assert off.ctx.pull.step_share == 1.0
+
+
+def test_a_lid_grasp_point_sliding_along_the_lip_between_looks_does_not_drag_the_hand_sideways() -> None:
+    """The middle of a lip's visible points moves along the hinge as the hand hides part of it: within
+    ``lid.along_slack`` of it the reach keeps the hand's place along the hinge, beyond it follows."""
+    from agents.scripted.phases.reach import PreGrasp
+
+    est = _closed_laptop()
+    goals = []
+    for seen_y in (0.05, 0.08, 0.13):  # the grasp point slides 3 cm, then 8 cm along the hinge
+        seen = JointAxisEstimate("revolute", est.direction, est.pivot, 0.0,
+                                 est.grasp_point + np.array([0.0, seen_y - 0.05, 0.0]))
+        opener = ScriptedOpener()
+        opener.act_on(seen, _pose(np.eye(3), np.array([-0.1, 0.05, 0.2])))  # the hand above y = 0.05
+        assert isinstance(opener.current, PreGrasp)
+        goals.append(opener.current.goal(opener.ctx, seen)[0])
+    assert goals[0][1] == pytest.approx(0.05) and goals[1][1] == pytest.approx(0.05)
+    assert goals[2][1] == pytest.approx(0.13 - 0.04)  # 8 cm off: followed to the slack's edge
+    plain = ScriptedOpener(_cfg(lid__along_slack=0.0))
+    plain.act_on(est, _pose(np.eye(3), np.array([-0.1, 0.09, 0.2])))
+    assert plain.current.goal(plain.ctx, est)[0][1] == pytest.approx(0.05)

@@ -84,7 +84,8 @@ class _Reach(OpenerPhase):
         axis (negative: outside the part), with the gripper's action for its approach gap."""
         choice, grip = ctx.grasp, ctx.grip(est)
         assert choice.target_r is not None
-        return grip.grasp_target(est) + choice.target_r[:, 2] * depth, gripper_action(grip.gap)
+        goal = grip.grasp_target(est) + choice.target_r[:, 2] * depth
+        return keep_along_axis(ctx, est, goal, grip.along_slack(est)), gripper_action(grip.gap)
 
     def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
         """The phase after the move ended (``ctx.move.reach_why`` says how)."""
@@ -130,7 +131,7 @@ class _Lift:
         if lift is None:
             return None
         goal, ctx.grasp.target_r = lift
-        return goal, GRIPPER_CLOSE
+        return keep_along_axis(ctx, est, goal, Lid(ctx.cfg).along_slack(est)), GRIPPER_CLOSE
 
 
 class LiftLineUp(_Lift, PreGrasp):
@@ -154,6 +155,17 @@ class LiftSlideUnder(_Lift, Approach):
             assert ctx.now is not None
             return pull.start_pull(ctx, ctx.now.p, ctx.now.r, est, "under")
         return super().next(ctx, est)
+
+
+def keep_along_axis(ctx: OpenerContext, est: JointAxisEstimate, goal: np.ndarray, slack: float) -> np.ndarray:
+    """``goal`` (3,) m moved along the estimated joint axis to the hand's own place there, by at most
+    ``slack`` m: where the grip is a line along the axis (a lid's lip), a grasp point that slides along
+    it from look to look does not drag the hand sideways."""
+    if slack <= 0.0 or ctx.now is None:
+        return goal
+    u = unit(est.direction)
+    offset = float((ctx.now.p - goal) @ u)
+    return goal + u * float(np.clip(offset, -slack, slack))
 
 
 def choose_grasp(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray, r: np.ndarray,
