@@ -11,7 +11,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from capt_env.wrappers.moving_part_geometry import PartPlane, bar_centre, outer_layer, part_plane, standing_off
+from capt_env.wrappers.moving_part_geometry import (
+    PartPlane,
+    bar_centre,
+    outer_layer,
+    part_plane,
+    standing_off,
+)
 
 _UP = np.array([0.0, 0.0, 1.0])
 
