@@ -79,6 +79,23 @@ def lid_frame(est: JointAxisEstimate) -> tuple[np.ndarray, np.ndarray] | None:
     return None if front is None else (front, outward_normal(est))
 
 
+def pitched_down(frame: np.ndarray, pitch: float) -> np.ndarray:
+    """TCP rotation ``frame`` (3, 3) whose approach (its z) points less than ``pitch`` rad below level
+    turned down to that pitch, about the horizontal axis across the approach: the Panda's wrist cannot
+    point level at table height, and a handle bar stays between the fingers (the bar is either along
+    that axis or perpendicular to the closing direction). ``frame`` itself for a vertical approach."""
+    approach = frame[:, 2]
+    elevation = float(np.arcsin(np.clip(approach[2], -1.0, 1.0)))
+    if elevation <= -pitch or perpendicular(approach, UP) is None:
+        return frame
+    side = np.cross(approach, UP)
+    side = side / np.linalg.norm(side)
+    rot = axis_angle_matrix(side, -(elevation + pitch))
+    if (rot @ approach)[2] > approach[2]:
+        rot = rot.T
+    return rot @ frame
+
+
 def nearer_finger_order(frame: np.ndarray, current: np.ndarray) -> np.ndarray:
     """Of TCP rotation ``frame`` (3, 3) and the same approach with the fingers swapped, the one
     nearer the current rotation ``current`` (3, 3)."""

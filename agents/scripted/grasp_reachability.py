@@ -22,7 +22,7 @@ import numpy as np
 
 from agents.scripted.config import ScriptedOpenerConfig
 from agents.scripted.geometry import axis_angle_matrix, grasp_frame, perpendicular
-from agents.scripted.grasp_pose import nearer_finger_order
+from agents.scripted.grasp_pose import nearer_finger_order, pitched_down
 from agents.scripted.panda_kinematics import (
     PANDA_LOWER,
     PANDA_UPPER,
@@ -78,14 +78,8 @@ def face_on_rotation(candidate: GraspCandidate, current: np.ndarray, pitch: floa
             closing = perpendicular(approach, np.array([0.0, 1.0, 0.0]))
     assert closing is not None
     frame = grasp_frame(approach, closing)
-    elevation = float(np.arcsin(np.clip(approach[2], -1.0, 1.0)))
-    side = perpendicular(approach, UP)
-    if pitch > 0.0 and elevation > -pitch and side is not None:
-        across = unit(np.cross(approach, UP))
-        turn = axis_angle_matrix(across, -(elevation + pitch))
-        if (turn @ approach)[2] > approach[2]:
-            turn = turn.T
-        frame = turn @ frame
+    if pitch > 0.0:
+        frame = pitched_down(frame, pitch)
     return nearer_finger_order(frame, current)
 
 

@@ -34,7 +34,7 @@ from agents.scripted.config import (
     SideDoorConfig,
     SlidingPanelConfig,
 )
-from agents.scripted.geometry import axis_angle_matrix, grasp_frame, off_axis, perpendicular
+from agents.scripted.geometry import grasp_frame, off_axis, perpendicular
 from agents.scripted.grasp_pose import (
     UP,
     falls_open,
@@ -43,6 +43,7 @@ from agents.scripted.grasp_pose import (
     lid_frame,
     nearer_finger_order,
     outward_normal,
+    pitched_down,
     slides_across_face,
 )
 from capt_env.wrappers.estimate import JointAxisEstimate, unit
@@ -121,21 +122,7 @@ class PartStrategy(ABC):
         if closing is None:
             closing = perpendicular(approach, np.array([0.0, 1.0, 0.0]))
             assert closing is not None
-        frame = grasp_frame(approach, closing)
-        elevation = float(np.arcsin(np.clip(approach[2], -1.0, 1.0)))
-        horizontal = perpendicular(approach, UP)
-        pitch = self.pitch
-        if elevation > -pitch and horizontal is not None:
-            # point the hand down by turning about the horizontal axis across the approach: the Panda's
-            # wrist cannot point level at table height, and a handle bar stays between the fingers
-            # (the bar is either along that axis or perpendicular to the closing direction)
-            side = np.cross(approach, UP)
-            side = side / np.linalg.norm(side)
-            rot = axis_angle_matrix(side, -(elevation + pitch))
-            if (rot @ approach)[2] > approach[2]:
-                rot = rot.T
-            frame = rot @ frame
-        return nearer_finger_order(frame, current)
+        return nearer_finger_order(pitched_down(grasp_frame(approach, closing), self.pitch), current)
 
     # -- fingers that closed on nothing --
 

@@ -127,11 +127,12 @@ class _Lift:
 
     def lift_goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float] | None:
         assert ctx.now is not None
-        lift = Lid(ctx.cfg).lift_pose(est, ctx.now.r, under=self.under)
+        lid = Lid(ctx.cfg)
+        lift = lid.lift_pose(est, ctx.now.r, under=self.under)
         if lift is None:
             return None
         goal, ctx.grasp.target_r = lift
-        return keep_along_axis(ctx, est, goal, Lid(ctx.cfg).along_slack(est)), GRIPPER_CLOSE
+        return keep_along_axis(ctx, est, goal, lid.along_slack(est)), GRIPPER_CLOSE
 
 
 class LiftLineUp(_Lift, PreGrasp):
