@@ -19,7 +19,13 @@ from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from capt_common.typed_yaml import require
 from capt_env.wrappers.estimate import unit
-from capt_env.wrappers.moving_part_geometry import PartPlane, bar_centre, part_plane, standing_off
+from capt_env.wrappers.moving_part_geometry import (
+    PartPlane,
+    bar_centre,
+    outer_layer,
+    part_plane,
+    standing_off,
+)
 
 GraspKind = Literal["bar", "knob", "recess", "edge"]
 KIND_PRIOR: dict[str, float] = {"bar": 3.0, "knob": 2.0, "recess": 1.0, "edge": 0.0}
@@ -170,7 +176,7 @@ def find_grasp_candidates(object_points: np.ndarray, part_points: np.ndarray, pl
 
     out = standing_off(obj, plane, lo - c.margin, hi + c.margin, c.min_standoff, c.max_standoff)
     for members in clusters(obj, out, c.link_radius, c.min_points):
-        grip = members[standoff[members] >= c.grip_share * float(np.quantile(standoff[members], 0.9))]
+        grip = members[outer_layer(obj[members], plane, c.grip_share)]
         if len(grip) < c.min_points:
             continue
         axis, length, width = _in_plane_extent(uv[grip], plane)

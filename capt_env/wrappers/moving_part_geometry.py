@@ -115,13 +115,13 @@ def handle_point(object_points: np.ndarray, part_points: np.ndarray, min_standof
     return bar_centre(object_points[keep], plane.outward if centre_across else None)
 
 
-def outer_layer(handle: np.ndarray, plane: PartPlane) -> np.ndarray:
-    """(M,) mask of a handle's points (M, 3) standing at least half as far out of ``plane`` as its
+def outer_layer(handle: np.ndarray, plane: PartPlane, share: float = 0.5) -> np.ndarray:
+    """(M,) mask of a handle's points (M, 3) standing at least ``share`` as far out of ``plane`` as its
     outermost ones (the 0.9 quantile): the bar a hand closes on. Surface bumps and noise sit just
     above the search band's floor, and the posts that hold a bar off the face run from the face to
     the bar: their points would pull a centroid towards the face, behind the bar."""
     standoff = (handle - plane.centre) @ plane.outward
-    return standoff >= 0.5 * float(np.quantile(standoff, 0.9))
+    return standoff >= share * float(np.quantile(standoff, 0.9))
 
 
 def standing_off(points: np.ndarray, plane: PartPlane, lo: np.ndarray, hi: np.ndarray,
