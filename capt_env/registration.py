@@ -35,6 +35,7 @@ CATEGORY_ENV_NAMES = {
     "eyeglasses": "Eyeglasses",
     "drawer_cabinet": "DrawerCabinet",
     "cabinet_door": "CabinetDoor",
+    "sliding_panel": "SlidingPanel",
 }
 GENERIC_ID = "CaptOpenArticulated-v0"
 GENERIC_MS_ID = "CaptOpenArticulated-ms-v0"

@@ -108,6 +108,9 @@ def build_articulated_object(
     if not scene.gpu_sim_enabled:
         # CPU: place the links now, so link and joint poses are valid before the first step
         art.set_root_pose(pose if pose is not None else sapien.Pose())  # a sapien.Pose: every sub-scene
+    for link in spec.links:
+        if link.balanced:
+            art.links_map[link.name].disable_gravity = True
     for joint in spec.joints:
         sim_joint = art.joints_map[joint.name]
         sim_joint.set_friction(joint.friction)

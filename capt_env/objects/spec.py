@@ -65,12 +65,15 @@ Shape = Cylinder | ConvexMesh
 @dataclass(frozen=True)
 class LinkSpec:
     """A rigid part. ``density`` in kg/m^3 sets the mass from the shapes' volume. ``shapes`` holds
-    the non-box geometry (empty for every category's default instances)."""
+    the non-box geometry (empty for every category's default instances). A ``balanced`` part is
+    counterweighted: gravity does not act on it (a sash window's balance holds the sash where it is
+    put)."""
 
     name: str
     boxes: tuple[Box, ...]
     density: float = 300.0
     shapes: tuple[Shape, ...] = ()
+    balanced: bool = False
 
 
 @dataclass(frozen=True)

@@ -104,6 +104,8 @@ def test_opening_moves_grasp_point_towards_front_or_up(category: str) -> None:
         assert delta[2] > 0.02
     elif category == "eyeglasses":
         assert delta[0] > 0.01  # temples unfold backwards (+x)
+    elif category == "sliding_panel":
+        assert abs(delta[0]) < 1e-9 and np.linalg.norm(delta[1:]) > 0.2  # across the front plane
     else:
         assert delta[0] < -0.02  # towards the robot (-x)
 
