@@ -29,8 +29,8 @@ CORPUS = [
     # a lid's lip swings up and back past the Panda's reach from 0.3 m: placed like the laptops
     ("mw_laptop", "objects/assets/laptop.xml", "laptop", {"object_xy": [-0.08, 0.0]}),
     ("mw_door", "objects/assets/doorlockB.xml", "cabinet_door", {"joint": "doorjoint"}),
-    ("mw_window", "objects/assets/window.xml", "drawer_cabinet", {}),
-    ("mw_window_horiz", "objects/assets/window_horiz.xml", "drawer_cabinet", {}),
+    ("mw_window", "objects/assets/window.xml", "sliding_panel", {}),
+    ("mw_window_horiz", "objects/assets/window_horiz.xml", "sliding_panel", {}),
 ]
 """The corpus: every Meta-World object with a door, lid, drawer or sliding panel a hand opens."""
 

@@ -23,8 +23,9 @@ from typing import Any
 
 from capt_env.tasks.config import USER_FILE_KEYS
 
-LIKE_BY_JOINT_TYPE = {0: "cabinet_door", 1: "drawer_cabinet"}
-"""Shipped model used for a user file without ``like``: by its target joint's type (0 revolute)."""
+SLIDE_ALONG_FRONT_MIN_COS = 0.7071
+"""A prismatic part whose slide is within 45 degrees of its front's normal is pulled out (a drawer);
+one sliding more across its front than out of it is a sliding panel (a window sash, a sliding door)."""
 _ENTRY_KEYS = {"path", "name", "like", "task"}
 _FILE_TASK_KEYS = set(USER_FILE_KEYS) | {"scale", "object_xy", "object_xy_noise", "yaw_noise",
                                           "target_init_fraction", "other_init_fraction",
@@ -51,19 +52,34 @@ class ObjectTarget:
             return self.category
         if self.like is not None:
             return self.like
-        return LIKE_BY_JOINT_TYPE[target_joint_type(self.task)]
+        return file_model_category(self.task)
 
 
-def target_joint_type(task: dict[str, Any]) -> int:
-    """Type id (0 revolute, 1 prismatic) of a user file's target joint, by building it once."""
+def file_model_category(task: dict[str, Any]) -> str:
+    """The shipped model that serves a user file (``task``: its TaskConfig keys), by building it
+    once: ``cabinet_door`` for a revolute target joint; for a prismatic one ``drawer_cabinet`` when
+    it slides out of the object's front, ``sliding_panel`` when it slides across it
+    (:data:`SLIDE_ALONG_FRONT_MIN_COS`)."""
+    import math
+
+    import numpy as np
+
+    from capt_common.typed_yaml import from_dict
     from capt_env.objects.scene import create_scene
-    from capt_env.objects.user_files import load_user_object
+    from capt_env.tasks.config import TaskConfig
+    from capt_env.tasks.object_loading import load_object
 
-    scene = create_scene(render=False)
-    _, info = load_user_object(scene, task["object"], joint=task.get("joint"), name="probe",
-                               visual_groups=tuple(task.get("visual_groups", (0, 1, 2))),
-                               mjcf_angle=task.get("mjcf_angle", "auto"))
-    return 1 if info["joint_type"] == "prismatic" else 0
+    cfg = from_dict(TaskConfig, {"category": None, **task}, where=f"object {task['object']}")
+    cfg.validate()
+    loaded = load_object(create_scene(render=True), cfg, np.random.RandomState(0))  # placed by its visuals
+    k = loaded.target_joint
+    if loaded.joint_type_ids[k] == 0:
+        return "cabinet_door"
+    pose = loaded.joints[k].get_global_pose().to_transformation_matrix()
+    axis = np.asarray(pose.reshape(-1, 4, 4)[0, :3, 0].cpu(), dtype=np.float64)
+    azimuth = math.pi - loaded.front_yaw  # the front's outward normal, object frame
+    front = np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
+    return "drawer_cabinet" if abs(float(axis @ front)) >= SLIDE_ALONG_FRONT_MIN_COS else "sliding_panel"
 
 
 def add_object_arguments(parser: argparse.ArgumentParser, categories_default: list[str] | None,
@@ -82,7 +98,8 @@ def add_object_arguments(parser: argparse.ArgumentParser, categories_default: li
     parser.add_argument("--scale", type=float, default=None, help="with --object: uniform scale")
     parser.add_argument("--like", default=None,
                         help="with --object: the category whose shipped model to use (default: by "
-                             "joint type, revolute cabinet_door, prismatic drawer_cabinet)")
+                             "joint: revolute cabinet_door, prismatic drawer_cabinet when it slides out "
+                             "of the front, sliding_panel when it slides across it)")
 
 
 def parse_front_yaw(value: str | None) -> float | str | None:

@@ -5,7 +5,7 @@ The body is a window frame (four bars, on a plinth or not) or an open-front cabi
 opening is split in two along the slide axis. The fixed pane fills one half in the back track; the
 sash fills the other half in the front track (each reaching ``overlap`` past the middle) and slides
 over the fixed pane: upwards, or sideways to the left or the right. The sash carries a bar or a knob
-near its leading or trailing edge, standing 3-10 cm off its face.
+near its leading or trailing edge or in its middle, standing 3-6 cm off its face.
 
 Zero/sign rule: state 0 = closed (the sash covers its half of the opening); the axis lies in the
 front plane, +z for a sash that slides up, +y or -y for one that slides sideways, so a positive
@@ -47,7 +47,7 @@ def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     handle_style = s.choice("handle_style", ("bar", "knob"))
     handle_edge = s.choice("handle_edge", ("leading", "trailing", "middle"))
     handle_t = s.uniform("handle_thickness", 0.012, 0.02)
-    standoff = s.uniform("handle_standoff", 0.03, 0.10)
+    standoff = s.uniform("handle_standoff", 0.03, 0.06)
     handle_len = s.uniform("handle_length_frac", 0.25, 0.6)
     handle_inset = s.uniform("handle_inset", 0.025, 0.05)
     across_frac = s.uniform("handle_across_frac", 0.35, 0.65)

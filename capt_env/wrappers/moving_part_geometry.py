@@ -57,6 +57,18 @@ def faces_along(plane: PartPlane | None, direction: np.ndarray, max_angle: float
     return abs(float(plane.outward @ unit(direction))) >= float(np.cos(max_angle))
 
 
+def slides_across(plane: PartPlane | None, direction: np.ndarray, max_angle: float = 0.6,
+                  max_tilt: float = 0.5) -> bool:
+    """Whether a part sliding along ``direction`` (3,) slides across ``plane`` (a window sash, a
+    sliding cabinet door): the slide's line lies within ``max_angle`` rad of the plane and the plane
+    stands upright, its normal within ``max_tilt`` rad of horizontal (an open drawer's bottom holds
+    its slide too, but it looks up). False for no plane."""
+    if plane is None:
+        return False
+    along_normal = abs(float(plane.outward @ unit(direction)))
+    return along_normal <= float(np.sin(max_angle)) and abs(float(plane.outward[2])) <= float(np.sin(max_tilt))
+
+
 def coplanar_panel(object_points: np.ndarray, part_points: np.ndarray, plane: PartPlane,
                    band: float = 0.01, link_radius: float = 0.03) -> np.ndarray:
     """The flat panel a segmented part lies on: the points (K, 3) of ``object_points`` (N, 3) within

@@ -83,3 +83,18 @@ def test_demo_estimates_an_object_file(drawer_urdf: Path, tmp_path: Path,
     assert "small_drawer_episode0 (user file)" in capsys.readouterr().out
     (row,) = json.loads(out.read_text())["episodes"]
     assert row["object"] == "small_drawer" and Path(row["png"]).is_file()
+
+
+@pytest.mark.parametrize(("category", "iid", "expected"), [
+    ("drawer_cabinet", 3, "drawer_cabinet"),   # slides out of its front
+    ("sliding_panel", 0, "sliding_panel"),     # a sash sliding up across its front
+    ("sliding_panel", 20, "sliding_panel"),    # one sliding sideways
+    ("cabinet_door", 1, "cabinet_door"),       # revolute
+])
+def test_a_file_without_like_gets_the_model_of_how_its_part_moves(category: str, iid: int, expected: str,
+                                                                   tmp_path: Path) -> None:
+    from capt_env.commands.object_targets import ObjectTarget
+
+    path = tmp_path / f"{category}.urdf"
+    path.write_text(spec_to_urdf(make_object(category, iid)))
+    assert ObjectTarget(label="file", task={"object": str(path)}).model_category() == expected

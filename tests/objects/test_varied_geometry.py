@@ -27,7 +27,7 @@ DEFAULT_SPEC_HASHES = {
     "eyeglasses": "48d48b6aee1edbe8",
     "drawer_cabinet": "418fb759177537b4",
     "cabinet_door": "3217e2ce16603e43",
-    "sliding_panel": "7dc6475a0df5ca8f",
+    "sliding_panel": "544bc5fed5d4f5ba",
 }
 
 

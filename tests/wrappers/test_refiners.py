@@ -192,6 +192,39 @@ def test_handle_does_not_fire_on_a_door_without_one() -> None:
     assert draft.estimate().grasp_point[1] > 0.15  # the fallback: the far edge from the hinge
 
 
+def _sash(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A window sash (label 1, the plane x = -0.2, y in [-0.2, 0.2], z in [0.1, 0.3]) with a
+    horizontal bar 5 cm out at (-0.25, 0, 0.13), in front of a fixed pane (label 0, x = -0.17, z in
+    [0.28, 0.5]) and the frame's sides (label 0)."""
+    sash = _box(rng, 500, -0.2, (-0.2, 0.2), (0.1, 0.3))
+    bar = _box(rng, 40, -0.25, (-0.05, 0.05), 0.13)
+    pane = _box(rng, 400, -0.17, (-0.2, 0.2), (0.28, 0.5))
+    sides = np.concatenate([_box(rng, 100, (-0.22, -0.15), y, (0.08, 0.52)) for y in (-0.22, 0.22)])
+    points = np.concatenate([sash, bar, pane, sides]) + rng.normal(0.0, 0.001, (1140, 3))
+    return points, np.concatenate([np.ones(540, int), np.zeros(600, int)])
+
+
+def test_handle_grasps_the_bar_on_a_sash_sliding_up_across_its_face() -> None:
+    """A sash slides in its face's plane: that upright face is where its handle stands off."""
+    points, labels = _sash(np.random.default_rng(0))
+    draft = _draft(points, labels, _slide((0.0, 0.0, 1.0)))
+    assert draft.plane is None and draft.face is not None  # no drawer front, a sliding face
+    assert Handle().refine(draft) and draft.from_handle
+    np.testing.assert_allclose(draft.grasp, [-0.25, 0.0, 0.13], atol=0.01)
+
+
+def test_handle_does_not_take_an_open_drawers_bottom_for_a_sliding_face() -> None:
+    """An open drawer's bottom holds its slide too, but looks up: its sides are no handles."""
+    rng = np.random.default_rng(0)
+    bottom = _box(rng, 500, (-0.45, -0.2), (-0.2, 0.2), 0.2)
+    sides = np.concatenate([_box(rng, 60, (-0.45, -0.2), y, 0.25) for y in (-0.19, 0.19)])
+    body = _box(rng, 400, (-0.2, 0.2), (-0.25, 0.25), 0.5)
+    points = np.concatenate([bottom, sides, body]) + rng.normal(0.0, 0.001, (1020, 3))
+    labels = np.concatenate([np.ones(620, int), np.zeros(400, int)])
+    draft = _draft(points, labels, _slide((-1.0, 0.0, 0.0)))
+    assert draft.face is None and not Handle().refine(draft)
+
+
 # ------------------------------------------------------------------------------------- front_normal
 def test_front_normal_slides_a_drawer_along_its_fronts_normal() -> None:
     points, labels = _drawer(np.random.default_rng(0))

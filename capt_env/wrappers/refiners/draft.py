@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 import numpy as np
 
 from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part, unit
-from capt_env.wrappers.moving_part_geometry import PartPlane, faces_along, part_plane
+from capt_env.wrappers.moving_part_geometry import PartPlane, faces_along, part_plane, slides_across
 
 if TYPE_CHECKING:
     from perception.inference import ArticulationEstimate, JointEstimate
@@ -77,6 +77,15 @@ class Draft:
             self.use_plane(moving_part_plane(self.points, self.moving, self.network.type,
                                              unit(self.network.direction)))
         return self._plane
+
+    @property
+    def face(self) -> PartPlane | None:
+        """The face a handle stands off: :attr:`plane`, or for a part that slides across its upright
+        face (a window sash, a sliding door; :func:`slides_across`) that face; None otherwise."""
+        if self.plane is not None or self.joint_type != "prismatic":
+            return self.plane
+        plane = part_plane(self.points, self.moving)
+        return plane if slides_across(plane, self.direction) else None
 
     def use_plane(self, plane: PartPlane | None) -> None:
         """Take ``plane`` as the moving part's plane (a stack's front for stacked drawers)."""

@@ -10,9 +10,12 @@ split into linked clusters, so two handles of a double door are two candidates, 
 between them, and stray points too few to be a handle, or a slab wider than a hand, are dropped. A
 bar is centred across its thickness too (the cameras see one side of it), except on a part swinging
 about a horizontal hinge (an oven door, a lid): measured, that moved an oven's grasp point off its bar.
+The face is the part's plane (:attr:`Draft.face`): a drawer's front, facing along its slide, or the
+upright face a sash or sliding door slides across.
 Must not fire: when a refiner already found the handle (``stacked_parts``), the part is not flat (or
-a prismatic part's face does not face along its slide), or no cluster of enough points standing off
-the face is a bar or knob no wider than ``max_width`` (the face's edge is the draft's own fallback).
+a prismatic part's face neither faces along its slide nor stands upright holding it), or no cluster
+of enough points standing off the face is a bar or knob no wider than ``max_width`` (the face's edge
+is the draft's own fallback).
 """
 
 from __future__ import annotations
@@ -52,12 +55,13 @@ class Handle:
         self.config = config or HandleConfig()
 
     def refine(self, draft: Draft) -> bool:
-        if draft.grasp is not None or draft.settled or draft.plane is None:
+        face = None if draft.grasp is not None or draft.settled else draft.face
+        if face is None:
             return False
         c = self.config
         across = draft.joint_type == "prismatic" or abs(float(draft.direction[2])) >= c.vertical_hinge_min_z
         found = find_grasp_candidates(
-            draft.handle_cloud, draft.panel, plane=draft.plane, centre_across=across,
+            draft.handle_cloud, draft.panel, plane=face, centre_across=across,
             config=GraspCandidateConfig(min_standoff=c.min_standoff, max_standoff=c.max_standoff,
                                         margin=c.margin, min_points=draft.handle_min_points))
         handles = [g for g in found if g.kind in ("bar", "knob")]
