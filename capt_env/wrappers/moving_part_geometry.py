@@ -66,7 +66,8 @@ def slides_across(plane: PartPlane | None, direction: np.ndarray, max_angle: flo
     if plane is None:
         return False
     along_normal = abs(float(plane.outward @ unit(direction)))
-    return along_normal <= float(np.sin(max_angle)) and abs(float(plane.outward[2])) <= float(np.sin(max_tilt))
+    upright = abs(float(plane.outward[2])) <= float(np.sin(max_tilt))
+    return along_normal <= float(np.sin(max_angle)) and upright
 
 
 def coplanar_panel(object_points: np.ndarray, part_points: np.ndarray, plane: PartPlane,
