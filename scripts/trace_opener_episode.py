@@ -17,6 +17,7 @@ import numpy as np
 from agents.scripted import ScriptedOpener
 from agents.scripted.geometry import quat_to_matrix
 from capt_env.commands.object_targets import load_objects_yaml, target_task
+from capt_env.commands.rollout import opener_config
 from capt_env.commands.task_overrides import task_overrides
 from capt_env.env_factory import make_env
 from capt_env.wrappers.joint_observation import decode_observation
@@ -34,6 +35,7 @@ def main() -> None:
     parser.add_argument("--perception", default="oracle", choices=["oracle", "capt", "capt_raw"],
                         help="perception source; capt/capt_raw use the object's shipped model (`like`)")
     parser.add_argument("--every-k-steps", type=int, default=5, help="perception every k control steps")
+    parser.add_argument("--opener", default=None, help="YAML of ScriptedOpenerConfig overrides")
     args = parser.parse_args()
     if args.seed >= 10000:
         raise SystemExit("seeds from 10000 are held out for reporting; trace development seeds")
@@ -50,7 +52,7 @@ def main() -> None:
         env = make_env(None, wrapper, task=target_task(target, task), obs_mode=obs_mode)
     else:
         env = make_env(args.name, wrapper, task=task, obs_mode=obs_mode)
-    opener = ScriptedOpener()
+    opener = ScriptedOpener(opener_config(args.opener))
     obs, info = env.reset(seed=args.seed)
     opener.reset()
     steps, last_phase = [], None
@@ -70,7 +72,7 @@ def main() -> None:
         row = {"step": step, "phase": opener.phase.value, "tcp": tcp[:3].round(4).tolist(),
                "gap": round(float(qpos[7] + qpos[8]), 4), "state": round(float(est.state), 4),
                "grasp": np.round(est.grasp_point, 4).tolist(),
-               "open_fraction": round(float(info["open_fraction"]), 3),
+               "open_fraction": round(float(info["open_fraction"]), 3), "success": bool(info["success"]),
                "action": np.round(action, 2).tolist(),
                "approach": np.round(quat_to_matrix(tcp[3:7])[:, 2], 3).tolist(),
                "closing": np.round(quat_to_matrix(tcp[3:7])[:, 1], 3).tolist(),
@@ -78,7 +80,8 @@ def main() -> None:
         steps.append(row)
         if opener.phase.value != last_phase or step % args.every == 0:
             print(f"{step:4d} {row['phase']:9s} tcp {row['tcp']} gap {row['gap']:.4f} "
-                  f"state {row['state']:+.3f} open {row['open_fraction']:.2f} grasp {row['grasp']} "
+                  f"state {row['state']:+.3f} open {row['open_fraction']:.2f} ok {int(row['success'])} "
+                  f"grasp {row['grasp']} "
                   f"act {row['action']} appr {row['approach']} clos {row['closing']} arm {row['arm']}")
             if opener.phase.value == "approach" and last_phase != "approach":
                 print("     rehearsals (nearer, other):", opener.rehearsals)

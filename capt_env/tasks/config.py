@@ -93,7 +93,8 @@ class TaskConfig:
       out takes room), the lower one on a tie. Joint states are then 0 closed and grow while opening.
     - ``joint_damping`` (N m s/rad or N s/m) and ``joint_friction`` (Coulomb, N m or N) replace the
       file's values on every movable joint; ``part_mass`` (kg) sets the moving link's mass (inertia
-      scaled with it); ``density`` (kg/m^3) is used for links whose file gives no mass.
+      scaled with it; a part lighter than ``object_loading.MIN_PART_MASS``, 50 g, is raised to it);
+      ``density`` (kg/m^3) is used for links whose file gives no mass.
     - ``grasp_point`` (metres, file frame at the closed state) or ``handle`` (the name of a link or
       geom on the moving part) sets the grasp target; default: a handle found by name, else by
       geometry (the part of the moving link standing off its outer face).

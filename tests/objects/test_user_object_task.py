@@ -184,6 +184,26 @@ def test_urdf_friction_becomes_a_capped_drive_and_part_mass_is_set(tmp_path: Pat
         env.close()
 
 
+def test_a_part_of_a_few_grams_is_given_the_least_mass_a_held_part_stays_still_with(tmp_path: Path) -> None:
+    """Held open in the fingers, an 11 g sash (Meta-World's window) was pushed about by the contact
+    solver and never counted as at rest: a part lighter than MIN_PART_MASS gets that mass, with a
+    warning; ``part_mass`` still sets any mass."""
+    from capt_env.tasks.object_loading import MIN_PART_MASS
+
+    light = cabinet_urdf().replace('<mass value="0.5"/>', '<mass value="0.011"/>')
+    env = make(tmp_path, light)
+    try:
+        assert float(env.object.target_child_link.mass[0]) == pytest.approx(MIN_PART_MASS, rel=1e-4)
+        assert any("weighs 0.011 kg" in w for w in env.object.warnings)
+    finally:
+        env.close()
+    env = make(tmp_path, light, part_mass=0.02)
+    try:
+        assert float(env.object.target_child_link.mass[0]) == pytest.approx(0.02, rel=1e-4)
+    finally:
+        env.close()
+
+
 def test_cylinder_and_capsule_geometry_lies_along_the_urdf_axis(tmp_path: Path) -> None:
     """ManiSkill's trimesh conversion turns SAPIEN's x-axis cylinders and capsules by 90 degrees;
     the task's own geometry must not: a 30 cm bar along the door's z stays 30 cm tall."""
