@@ -21,7 +21,7 @@ from capt_common.json_report import write_json
 from capt_env.commands.object_targets import add_object_arguments, object_targets, target_task
 from capt_env.commands.task_overrides import add_task_argument, task_overrides
 
-OPENED_CATEGORIES = ("laptop", "oven", "washing_machine", "drawer_cabinet", "cabinet_door")
+OPENED_CATEGORIES = ("laptop", "oven", "washing_machine", "drawer_cabinet", "cabinet_door", "sliding_panel")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -18,6 +18,7 @@ from capt_env.wrappers.refiners.front_normal import FrontNormal
 from capt_env.wrappers.refiners.handle import Handle
 from capt_env.wrappers.refiners.hinge_on_edge import HingeOnEdge
 from capt_env.wrappers.refiners.opening_sign import OpeningSign
+from capt_env.wrappers.refiners.slide_over_pane import SlideOverPane
 from capt_env.wrappers.refiners.stacked_parts import StackedParts
 from perception.inference import ArticulationEstimate, JointEstimate
 
@@ -223,6 +224,45 @@ def test_handle_does_not_take_an_open_drawers_bottom_for_a_sliding_face() -> Non
     labels = np.concatenate([np.ones(620, int), np.zeros(400, int)])
     draft = _draft(points, labels, _slide((-1.0, 0.0, 0.0)))
     assert draft.face is None and not Handle().refine(draft)
+
+
+# ---------------------------------------------------------------------------------- slide_over_pane
+@pytest.mark.parametrize("network", [(0.0, 1.0, 0.0), (0.0, -0.6, -0.8), (-0.3, 0.5, 0.8)])
+def test_slide_over_pane_turns_a_sash_up_over_the_pane_above_it(network: tuple[float, float, float]) -> None:
+    """The sash's pane is above it, one track behind: the sash slides up, whatever the network said
+    about its slide within (or near) its face."""
+    points, labels = _sash(np.random.default_rng(0))
+    draft = _draft(points, labels, _slide(network))
+    assert SlideOverPane().refine(draft)
+    np.testing.assert_allclose(draft.direction, [0.0, 0.0, 1.0], atol=1e-3)
+
+
+def test_slide_over_pane_finds_a_pane_beside_a_sideways_sash() -> None:
+    """Turned a quarter about the face's normal: the pane lies to the sash's left (+y)."""
+    points, labels = _sash(np.random.default_rng(0))
+    y, z = points[:, 1].copy(), points[:, 2].copy()
+    points[:, 1], points[:, 2] = z - 0.3, -y + 0.3  # (y, z) -> (z, -y) about (y, z) = (0, 0.3)
+    draft = _draft(points, labels, _slide((0.0, 0.0, 1.0)))
+    assert SlideOverPane().refine(draft)
+    np.testing.assert_allclose(draft.direction, [0.0, 1.0, 0.0], atol=1e-3)
+
+
+@pytest.mark.parametrize("case", ["drawer", "hinge", "no_pane"])
+def test_slide_over_pane_does_not_fire_without_a_sash_over_a_pane(case: str) -> None:
+    rng = np.random.default_rng(0)
+    if case == "drawer":  # slides out of its front: no sash
+        points, labels = _drawer(rng)
+        draft = _draft(points, labels, _slide((-1.0, 0.0, 0.0)))
+    elif case == "hinge":
+        points, labels = _door(rng)
+        draft = _draft(points, labels, _hinge())
+    else:  # a sliding door alone in its frame: nothing behind it to slide over
+        points, labels = _sash(rng)
+        keep = ~((labels == 0) & (points[:, 0] > -0.18) & (points[:, 2] > 0.27))
+        draft = _draft(points[keep], labels[keep], _slide((0.0, 1.0, 0.0)))
+    before = draft.direction.copy()
+    assert not SlideOverPane().refine(draft)
+    np.testing.assert_array_equal(draft.direction, before)
 
 
 # ------------------------------------------------------------------------------------- front_normal

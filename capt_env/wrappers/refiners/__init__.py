@@ -9,10 +9,11 @@ none; ``capt`` runs those the wrapper config names (``refiners``, default all), 
 2. ``stacked_parts``: in a drawer stack, the target is the k-th handle from the bottom.
 3. ``coplanar_panel``: a closed part's edges and handle are looked for on its whole flat panel.
 4. ``edge_direction``: a hinge's direction is turned onto the nearer edge of its rectangular part.
-5. ``handle``: the grasp point is the handle standing off the part's face.
-6. ``front_normal``: a drawer slides along its front's normal.
-7. ``hinge_on_edge``: a hinge's line is put on the part's edge away from the handle.
-8. ``opening_sign``: the axis is signed so that opening moves the part out of its body.
+5. ``slide_over_pane``: a sash slides along its track over the pane behind it.
+6. ``handle``: the grasp point is the handle standing off the part's face.
+7. ``front_normal``: a drawer slides along its front's normal.
+8. ``hinge_on_edge``: a hinge's line is put on the part's edge away from the handle.
+9. ``opening_sign``: the axis is signed so that opening moves the part out of its body.
 """
 
 from __future__ import annotations
@@ -30,10 +31,11 @@ from capt_env.wrappers.refiners.front_normal import FrontNormal, FrontNormalConf
 from capt_env.wrappers.refiners.handle import Handle, HandleConfig
 from capt_env.wrappers.refiners.hinge_on_edge import HingeOnEdge, HingeOnEdgeConfig
 from capt_env.wrappers.refiners.opening_sign import OpeningSign, OpeningSignConfig
+from capt_env.wrappers.refiners.slide_over_pane import SlideOverPane, SlideOverPaneConfig
 from capt_env.wrappers.refiners.stacked_parts import StackedParts, StackedPartsConfig
 
-RefinerName = Literal["dense_handle_search", "stacked_parts", "coplanar_panel", "edge_direction", "handle",
-                      "front_normal", "hinge_on_edge", "opening_sign"]
+RefinerName = Literal["dense_handle_search", "stacked_parts", "coplanar_panel", "edge_direction",
+                      "slide_over_pane", "handle", "front_normal", "hinge_on_edge", "opening_sign"]
 REFINER_NAMES: tuple[RefinerName, ...] = get_args(RefinerName)
 """Every refiner's name, in the order they run."""
 
@@ -47,6 +49,7 @@ class RefinerSettings:
     stacked_parts: StackedPartsConfig = field(default_factory=StackedPartsConfig)
     coplanar_panel: CoplanarPanelConfig = field(default_factory=CoplanarPanelConfig)
     edge_direction: EdgeDirectionConfig = field(default_factory=EdgeDirectionConfig)
+    slide_over_pane: SlideOverPaneConfig = field(default_factory=SlideOverPaneConfig)
     handle: HandleConfig = field(default_factory=HandleConfig)
     front_normal: FrontNormalConfig = field(default_factory=FrontNormalConfig)
     hinge_on_edge: HingeOnEdgeConfig = field(default_factory=HingeOnEdgeConfig)
@@ -57,8 +60,8 @@ class RefinerSettings:
             getattr(self, name).validate()
 
 
-_CLASSES = {cls.name: cls for cls in (DenseHandleSearch, StackedParts, CoplanarPanel, EdgeDirection, Handle,
-                                      FrontNormal, HingeOnEdge, OpeningSign)}
+_CLASSES = {cls.name: cls for cls in (DenseHandleSearch, StackedParts, CoplanarPanel, EdgeDirection,
+                                      SlideOverPane, Handle, FrontNormal, HingeOnEdge, OpeningSign)}
 assert tuple(_CLASSES) == REFINER_NAMES
 
 
