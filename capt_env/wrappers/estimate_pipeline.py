@@ -60,24 +60,29 @@ def network_input(points: np.ndarray, num: int, rng: np.random.Generator) -> np.
 class Look:
     """One run of the network: its input ``points`` (M, 3), all isolated ``dense_points`` (K, 3) (or
     None), the ``target`` joint index, the network's output ``result`` (part labels, joints after
-    double voting) and the ``model`` config it came from. World frame, metres."""
+    double voting), the ``model`` config it came from and the cameras' mean position ``viewpoint``
+    (3,) (or None). World frame, metres."""
 
     points: np.ndarray
     dense_points: np.ndarray | None
     target: int
     result: ArticulationEstimate
     model: Any
+    viewpoint: np.ndarray | None = None
 
 
-def look(estimator: Any, points: np.ndarray, target: int, dense_points: np.ndarray | None = None) -> Look:
+def look(estimator: Any, points: np.ndarray, target: int, dense_points: np.ndarray | None = None,
+         viewpoint: np.ndarray | None = None) -> Look:
     """Run ``estimator`` (a ``perception.inference.ArticulationEstimator``) on ``points`` (M, 3)."""
     points = np.asarray(points, dtype=np.float64)
-    return Look(points, dense_points, int(target), estimator.predict(points), estimator.config.model)
+    view = None if viewpoint is None else np.asarray(viewpoint, dtype=np.float64).reshape(3)
+    return Look(points, dense_points, int(target), estimator.predict(points), estimator.config.model, view)
 
 
 def network(seen: Look) -> Draft:
     """The network's own estimate of the target joint, as a draft the refiners can change."""
-    return network_draft(seen.result, seen.points, seen.target, seen.model, seen.dense_points)
+    return network_draft(seen.result, seen.points, seen.target, seen.model, seen.dense_points,
+                         seen.viewpoint)
 
 
 # ------------------------------------------------------------------------------------ 3. refine

@@ -40,7 +40,9 @@ class GraspCandidateConfig:
     ``min_standoff`` (m): handle points stand at least this far out of the face (above its surface
     noise and the plane fit's 1 cm band). ``max_standoff`` (m): and at most this far (levers stand
     10-12.5 cm off a panel; farther is another body in front of it). ``margin`` (m): the face's
-    in-plane extent is grown by it (a view may show only some of the part, a handle may overhang).
+    in-plane extent is grown by it (a view may show only some of the part, a handle may overhang);
+    ``mount_tolerance`` (m): a candidate within it of the part's own extent lies over the part
+    (scores higher: see :func:`_score`).
     ``link_radius`` (m): points of one handle are linked when this close (the gaps of a sparse view,
     ~1.5 cm, are smaller; two handles of a double door, >= 10 cm apart, are not linked).
     ``min_points``: a cluster needs this many points (fewer are stray points, not a handle).
@@ -70,6 +72,7 @@ class GraspCandidateConfig:
     min_standoff: float = 0.01
     max_standoff: float = 0.15
     margin: float = 0.05
+    mount_tolerance: float = 0.01
     link_radius: float = 0.03
     min_points: int = 3
     grip_share: float = 0.5
@@ -90,7 +93,8 @@ class GraspCandidateConfig:
     def validate(self) -> None:
         require(0.0 <= self.min_standoff < self.max_standoff,
                 "grasp_candidates.min_standoff must be >= 0 and below max_standoff (metres)")
-        require(self.margin >= 0, "grasp_candidates.margin must be >= 0 (metres)")
+        require(self.margin >= 0 and self.mount_tolerance >= 0,
+                "grasp_candidates.margin and mount_tolerance must be >= 0 (metres)")
         require(self.link_radius > 0, "grasp_candidates.link_radius must be > 0 (metres)")
         require(self.min_points >= 1, "grasp_candidates.min_points must be >= 1")
         require(0.0 <= self.grip_share <= 1.0, "grasp_candidates.grip_share must be in [0, 1]")
@@ -201,17 +205,21 @@ def find_grasp_candidates(object_points: np.ndarray, part_points: np.ndarray, pl
     candidates = []
     for kind, point, axis, members, width, grip in found:
         clearance = _clearance(obj, standoff, members, point, plane.outward, c)
+        point_uv = (point - plane.centre) @ plane.in_plane.T
+        mounted = bool(np.all((point_uv >= lo - c.mount_tolerance) & (point_uv <= hi + c.mount_tolerance)))
         candidates.append(GraspCandidate(kind, point, plane.outward.copy(), axis, float(width), clearance,
-                                         _score(kind, clearance, c), len(grip)))
+                                         _score(kind, clearance, mounted, c), len(grip)))
     candidates.sort(key=lambda g: -g.score)
     edge = _edge_candidate(obj, part, plane, c, hinge_direction, hinge_pivot)
     return candidates if edge is None else [*candidates, edge]
 
 
-def _score(kind: GraspKind, clearance: float, c: GraspCandidateConfig) -> float:
-    """A candidate's geometric score: its kind's prior (:data:`KIND_PRIOR`, one apart) plus up to 0.5
-    for the share of the approach corridor's radius that is free."""
-    return KIND_PRIOR[kind] + 0.5 * min(clearance / c.corridor_radius, 1.0)
+def _score(kind: GraspKind, clearance: float, mounted: bool, c: GraspCandidateConfig) -> float:
+    """A candidate's geometric score: its kind's prior (:data:`KIND_PRIOR`, one apart), plus up to 0.5
+    for the share of the approach corridor's radius that is free, plus 0.5 when it lies over the part
+    itself (``mounted``): a handle is fixed to its part, while the margin around the part also takes in
+    the edge of a body standing out beside it (a window's plinth under its sash)."""
+    return KIND_PRIOR[kind] + 0.5 * min(clearance / c.corridor_radius, 1.0) + 0.5 * float(mounted)
 
 
 def clusters(points: np.ndarray, mask: np.ndarray, link_radius: float, min_points: int) -> list[np.ndarray]:
@@ -334,4 +342,4 @@ def _edge_candidate(obj: np.ndarray, part: np.ndarray, plane: PartPlane, c: Gras
     standoff = (obj - plane.centre) @ plane.outward
     clearance = _clearance(obj, standoff, np.zeros(0, dtype=np.int64), point, plane.outward, c)
     return GraspCandidate("edge", point, plane.outward.copy(), edge_line, 0.0, clearance,
-                          _score("edge", clearance, c), len(on_face))
+                          _score("edge", clearance, True, c), len(on_face))

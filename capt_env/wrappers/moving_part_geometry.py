@@ -57,6 +57,13 @@ def faces_along(plane: PartPlane | None, direction: np.ndarray, max_angle: float
     return abs(float(plane.outward @ unit(direction))) >= float(np.cos(max_angle))
 
 
+def facing(plane: PartPlane, viewpoint: np.ndarray) -> PartPlane:
+    """``plane`` with its outward normal turned towards ``viewpoint`` (3,), world frame."""
+    if float((np.asarray(viewpoint, dtype=np.float64) - plane.centre) @ plane.outward) >= 0.0:
+        return plane
+    return PartPlane(plane.centre, plane.in_plane, -plane.outward)
+
+
 def slides_across(plane: PartPlane | None, direction: np.ndarray, max_angle: float = 0.6,
                   max_tilt: float = 0.5) -> bool:
     """Whether a part sliding along ``direction`` (3,) slides across ``plane`` (a window sash, a

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -116,3 +117,18 @@ def isolation_quality(mask: np.ndarray, part_label: np.ndarray) -> IsolationQual
     recall = hit / max(int(truth.sum()), 1)
     precision = hit / kept if kept else 0.0
     return IsolationQuality(recall, precision, 1.0 - precision, kept, int(truth.sum()))
+
+
+def camera_viewpoint(obs: Any) -> np.ndarray | None:
+    """The mean position (3,) of the cameras in a pointcloud observation (``sensor_param``'s
+    ``cam2world_gl`` of each, first sub-scene), world frame, metres; None without camera
+    parameters."""
+    params = obs.get("sensor_param") if isinstance(obs, dict) else None
+    if not params:
+        return None
+    eyes = []
+    for cam in params.values():
+        pose = cam["cam2world_gl"]
+        pose = pose.cpu().numpy() if hasattr(pose, "cpu") else np.asarray(pose)
+        eyes.append(np.asarray(pose, dtype=np.float64).reshape(-1, 4, 4)[0, :3, 3])
+    return np.mean(eyes, axis=0)

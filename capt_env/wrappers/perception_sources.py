@@ -32,10 +32,12 @@ class PerceptionSource(Protocol):
     needs_points: bool
 
     def estimate(self, points: np.ndarray | None, info: dict[str, Any],
-                 dense_points: np.ndarray | None = None) -> JointAxisEstimate:
+                 dense_points: np.ndarray | None = None,
+                 viewpoint: np.ndarray | None = None) -> JointAxisEstimate:
         """Estimate from object points (M, 3) world frame metres (or None) and the env's info.
         ``dense_points`` (K, 3), K >= M: all isolated object points before downsampling, for
-        geometry that needs more than the model's input (a source may ignore them)."""
+        geometry that needs more than the model's input; ``viewpoint`` (3,): where the cameras look
+        from (their mean position), world frame (a source may ignore both)."""
         ...
 
 
@@ -61,7 +63,8 @@ class OracleSource:
     needs_points = False
 
     def estimate(self, points: np.ndarray | None, info: dict[str, Any],
-                 dense_points: np.ndarray | None = None) -> JointAxisEstimate:
+                 dense_points: np.ndarray | None = None,
+                 viewpoint: np.ndarray | None = None) -> JointAxisEstimate:
         return ground_truth_estimate(info)
 
 
@@ -100,7 +103,8 @@ class NoisyOracleSource:
         self._held = None
 
     def estimate(self, points: np.ndarray | None, info: dict[str, Any],
-                 dense_points: np.ndarray | None = None) -> JointAxisEstimate:
+                 dense_points: np.ndarray | None = None,
+                 viewpoint: np.ndarray | None = None) -> JointAxisEstimate:
         gt = ground_truth_estimate(info)
         n, rng = self.noise, self.rng
         outward = n.grasp_outward_m * away_from_joint(gt)
@@ -160,10 +164,11 @@ class CaptSource:
         return self._estimator
 
     def estimate(self, points: np.ndarray | None, info: dict[str, Any],
-                 dense_points: np.ndarray | None = None) -> JointAxisEstimate:
+                 dense_points: np.ndarray | None = None,
+                 viewpoint: np.ndarray | None = None) -> JointAxisEstimate:
         if points is None:
             raise ValueError(f"the {self.name} source needs the object's points")
-        self.last_look = look(self._load(), points, _target(info), dense_points)
+        self.last_look = look(self._load(), points, _target(info), dense_points, viewpoint)
         return self.pipeline.estimate(self.last_look)
 
 

@@ -30,6 +30,7 @@ from capt_env.wrappers.config import PerceptionWrapperConfig
 from capt_env.wrappers.estimate import JointAxisEstimate
 from capt_env.wrappers.estimate_pipeline import isolate_object, network_input, observe
 from capt_env.wrappers.joint_observation import dict_space, flat_space
+from capt_env.wrappers.object_isolation import camera_viewpoint
 from capt_env.wrappers.perception_sources import PerceptionSource, make_source
 from capt_env.wrappers.robot_filter import RobotPointFilter
 
@@ -101,7 +102,8 @@ class CaptObservationWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
                                                        0.0, np.zeros(3), 0.0)
                 return (time.perf_counter() - t0) * 1000.0
             fed = network_input(points, self.config.num_points, self._rng)
-            self._estimate = self.source.estimate(fed, info, dense_points=points)
+            self._estimate = self.source.estimate(fed, info, dense_points=points,
+                                                  viewpoint=camera_viewpoint(obs))
         else:
             self._estimate = self.source.estimate(None, info)
         return (time.perf_counter() - t0) * 1000.0

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 import numpy as np
 
 from capt_env.wrappers.estimate import JointAxisEstimate, canonical_pivot, grasp_point_of_part, unit
-from capt_env.wrappers.moving_part_geometry import PartPlane, faces_along, part_plane, slides_across
+from capt_env.wrappers.moving_part_geometry import PartPlane, faces_along, facing, part_plane, slides_across
 
 if TYPE_CHECKING:
     from perception.inference import ArticulationEstimate, JointEstimate
@@ -34,7 +34,7 @@ class Draft:
     when it labels fewer than 3), ``network`` its estimate of the target joint (``joint_index``,
     ``type``, ``direction``, ``pivot``, ``state``, ``confidence``), ``model`` the model's config
     (``joint_child_parts``, ``joint_types``), ``target`` the joint's index, ``dense_points`` (D, 3)
-    all isolated object points (or None).
+    all isolated object points (or None), ``viewpoint`` (3,) the cameras' mean position (or None).
 
     Working geometry (refiners may replace it): ``handle_cloud`` the points handles are looked for
     among and ``handle_min_points`` the fewest points of a handle there; ``panel`` the flat panel the
@@ -64,6 +64,7 @@ class Draft:
     confidence: float
     grasp: np.ndarray | None = None
     from_handle: bool = False
+    viewpoint: np.ndarray | None = None
     fired: list[str] = field(default_factory=list)
     _plane: PartPlane | None = field(default=None, repr=False)
     _plane_known: bool = field(default=False, repr=False)
@@ -84,8 +85,18 @@ class Draft:
         face (a window sash, a sliding door; :func:`slides_across`) that face; None otherwise."""
         if self.plane is not None or self.joint_type != "prismatic":
             return self.plane
-        plane = part_plane(self.points, self.moving)
+        plane = self.sliding_face()
         return plane if slides_across(plane, self.direction) else None
+
+    def sliding_face(self) -> PartPlane | None:
+        """The moving part's plane with its outward normal turned towards ``viewpoint`` (a sash in
+        front of its pane is seen from its outer side; the away-from-the-body rule of
+        :func:`part_plane` turns it round when a handle and a plinth standing out in front outweigh
+        a thin frame behind), or as :func:`part_plane` orients it without a viewpoint."""
+        plane = part_plane(self.points, self.moving)
+        if plane is None or self.viewpoint is None:
+            return plane
+        return facing(plane, self.viewpoint)
 
     def use_plane(self, plane: PartPlane | None) -> None:
         """Take ``plane`` as the moving part's plane (a stack's front for stacked drawers)."""
@@ -139,7 +150,7 @@ def moving_part_plane(points: np.ndarray, moving: np.ndarray, joint_type: str,
 
 
 def network_draft(result: ArticulationEstimate, points: np.ndarray, target: int, model: Any,
-                  dense_points: np.ndarray | None = None) -> Draft:
+                  dense_points: np.ndarray | None = None, viewpoint: np.ndarray | None = None) -> Draft:
     """The draft of the network's estimate ``result`` of the cloud ``points`` (M, 3) for joint
     ``target`` (clipped to the joints the model has): its own type, direction, pivot, state and
     confidence; the moving part is the points labelled with the joint's child part (all points when
@@ -163,4 +174,4 @@ def network_draft(result: ArticulationEstimate, points: np.ndarray, target: int,
                  dense_points=dense, handle_cloud=points, handle_min_points=MIN_HANDLE_POINTS,
                  panel=moving, joint_type=joint.type, direction=unit(joint.direction),
                  pivot=np.asarray(joint.pivot, dtype=np.float64), state=float(joint.state),
-                 confidence=float(joint.confidence))
+                 confidence=float(joint.confidence), viewpoint=viewpoint)

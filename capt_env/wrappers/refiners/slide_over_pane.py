@@ -27,7 +27,7 @@ import numpy as np
 
 from capt_common.typed_yaml import require
 from capt_env.wrappers.estimate import unit
-from capt_env.wrappers.moving_part_geometry import PartPlane, part_plane
+from capt_env.wrappers.moving_part_geometry import PartPlane
 from capt_env.wrappers.refiners.draft import Draft
 
 
@@ -74,7 +74,7 @@ class SlideOverPane:
         if draft.joint_type != "prismatic" or len(draft.moving) == len(draft.points):
             return False
         c = self.config
-        face = part_plane(draft.points, draft.moving)
+        face = draft.sliding_face()
         if face is None or abs(float(face.outward[2])) > np.sin(c.max_tilt):
             return False
         before = unit(draft.direction)
