@@ -64,12 +64,13 @@ def facing(plane: PartPlane, viewpoint: np.ndarray) -> PartPlane:
     return PartPlane(plane.centre, plane.in_plane, -plane.outward)
 
 
-def slides_across(plane: PartPlane | None, direction: np.ndarray, max_angle: float = 0.6,
+def slides_across(plane: PartPlane | None, direction: np.ndarray, max_angle: float = np.pi / 2 - 0.6,
                   max_tilt: float = 0.5) -> bool:
     """Whether a part sliding along ``direction`` (3,) slides across ``plane`` (a window sash, a
-    sliding cabinet door): the slide's line lies within ``max_angle`` rad of the plane and the plane
-    stands upright, its normal within ``max_tilt`` rad of horizontal (an open drawer's bottom holds
-    its slide too, but it looks up). False for no plane."""
+    sliding cabinet door): the slide's line lies within ``max_angle`` rad of the plane (by default
+    wherever :func:`faces_along` does not hold: a sliding part either comes out of its face or runs
+    across it) and the plane stands upright, its normal within ``max_tilt`` rad of horizontal (an
+    open drawer's bottom holds its slide too, but it looks up). False for no plane."""
     if plane is None:
         return False
     along_normal = abs(float(plane.outward @ unit(direction)))

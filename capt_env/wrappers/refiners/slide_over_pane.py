@@ -13,7 +13,7 @@ nothing on the others. A single view's network estimate of a sash mixes up and s
 which side the pane is on is plain in the cloud (with the true segmentation of 100 unseen
 procedural test clouds: 72 right, 3 wrong, 25 left to the network).
 Must not fire: on a revolute joint; on a part without an upright flat face, or one the
-network does not see sliding within ``max_out_of_plane`` of that face (a drawer slides out of its
+network does not see sliding across that face (:func:`slides_across`: a drawer slides out of its
 front); when the best side holds fewer than ``min_points`` such points or fewer than ``dominance``
 times the next side's.
 """
@@ -27,39 +27,37 @@ import numpy as np
 
 from capt_common.typed_yaml import require
 from capt_env.wrappers.estimate import unit
-from capt_env.wrappers.moving_part_geometry import PartPlane
+from capt_env.wrappers.moving_part_geometry import PartPlane, slides_across
 from capt_env.wrappers.refiners.draft import Draft
 
 
 @dataclass(frozen=True)
 class SlideOverPaneConfig:
     """Metres and radians: ``min_depth``..``max_depth`` how far behind the sash's face pane points
-    lie, counted in the densest ``slab`` thick layer parallel to the face; ``reach`` the longest
+    lie, counted in the densest ``slab`` thick layer parallel to the face, which must spread over
+    ``min_spread`` of the strip's length (a surface running back from the face, a plinth's top or a
+    cabinet's side, is a line in the face's plane); ``reach`` the longest
     strip looked at beside the sash; ``across_share`` the share of the sash's width the strip spans
     (its middle, clear of a frame's reveals); ``min_points`` and
-    ``dominance`` how many pane points the best side needs, alone and against the next side;
-    ``max_out_of_plane`` the network's slide lies within it of the face; ``max_tilt`` the face's
-    normal lies within it of horizontal (an upright face)."""
+    ``dominance`` how many pane points the best side needs, alone and against the next side."""
 
     min_depth: float = 0.005
     max_depth: float = 0.05
     slab: float = 0.01
+    min_spread: float = 0.3
     reach: float = 0.3
     across_share: float = 0.8
     min_points: int = 10
     dominance: float = 2.0
-    max_out_of_plane: float = 1.0
-    max_tilt: float = 0.5
 
     def validate(self) -> None:
         require(0.0 <= self.min_depth < self.max_depth,
                 "slide_over_pane.min_depth must be >= 0 and below max_depth (metres)")
         require(self.reach > 0 and self.slab > 0, "slide_over_pane.reach and slab must be > 0 (metres)")
+        require(0.0 <= self.min_spread <= 1.0, "slide_over_pane.min_spread must be in [0, 1]")
         require(0.0 < self.across_share <= 1.0, "slide_over_pane.across_share must be in (0, 1]")
         require(self.min_points >= 1 and self.dominance >= 1.0,
                 "slide_over_pane.min_points must be >= 1 and dominance >= 1")
-        require(0.0 < self.max_out_of_plane <= 1.58 and 0.0 < self.max_tilt <= 1.58,
-                "slide_over_pane.max_out_of_plane and max_tilt must be in (0, pi/2] rad")
 
 
 class SlideOverPane:
@@ -75,11 +73,10 @@ class SlideOverPane:
             return False
         c = self.config
         face = draft.sliding_face()
-        if face is None or abs(float(face.outward[2])) > np.sin(c.max_tilt):
-            return False
         before = unit(draft.direction)
-        if abs(float(before @ face.outward)) > np.sin(c.max_out_of_plane):
+        if not slides_across(face, before):
             return False
+        assert face is not None
         towards = pane_side(draft.points, draft.moving, face, c)
         if towards is None:
             return False
@@ -108,7 +105,9 @@ def pane_side(points: np.ndarray, moving: np.ndarray, face: PartPlane,
         length = min(float(s_sash.max() - s_sash.min()), c.reach)
         t_mid, t_half = float(t_sash.max() + t_sash.min()) / 2, c.across_share * float(np.ptp(t_sash)) / 2
         in_strip = (s > s_sash.max()) & (s <= s_sash.max() + length) & (np.abs(t - t_mid) <= t_half)
-        counts.append((_densest_layer(depth[in_strip], c.slab), along))
+        layer = _densest_layer(depth[in_strip], c.slab)
+        spread = float(np.ptp(s[in_strip][layer])) if layer.any() else 0.0
+        counts.append((int(layer.sum()) if spread >= c.min_spread * length else 0, along))
     counts.sort(key=lambda x: -x[0])
     best, runner_up = counts[0][0], counts[1][0]
     if best < c.min_points or best < c.dominance * runner_up:
@@ -116,11 +115,13 @@ def pane_side(points: np.ndarray, moving: np.ndarray, face: PartPlane,
     return unit(counts[0][1])
 
 
-def _densest_layer(depth: np.ndarray, slab: float) -> int:
-    """The most of ``depth`` values (m) within one ``slab`` thick layer: a pane parallel to the face
-    packs its points into one layer; a surface running back from the face (a cabinet's side) spreads
-    them over every depth."""
+def _densest_layer(depth: np.ndarray, slab: float) -> np.ndarray:
+    """Mask of the most ``depth`` values (m) within one ``slab`` thick layer: a pane parallel to the
+    face packs its points into one layer; a surface running back from the face (a cabinet's side)
+    spreads them over every depth."""
     if len(depth) == 0:
-        return 0
+        return np.zeros(0, dtype=bool)
     d = np.sort(depth)
-    return int((np.searchsorted(d, d + slab, side="right") - np.arange(len(d))).max())
+    counts = np.searchsorted(d, d + slab, side="right") - np.arange(len(d))
+    start = d[int(np.argmax(counts))]
+    return (depth >= start) & (depth <= start + slab)
