@@ -40,7 +40,7 @@ def test_user_errors_are_one_line_with_exit_status_2() -> None:
     assert "Traceback" not in result.stderr
     assert result.stderr.strip().splitlines() == [
         "capt rollout: error: unknown category 'foo'; known: ['laptop', 'oven', 'washing_machine', "
-        "'eyeglasses', 'drawer_cabinet', 'cabinet_door']"]
+        "'eyeglasses', 'drawer_cabinet', 'cabinet_door', 'sliding_panel']"]
     missing = _capt("inspect-object", "/no/such/file.urdf")
     assert missing.returncode == 2 and "Traceback" not in missing.stderr
     assert "file not found" in missing.stderr

@@ -247,19 +247,25 @@ def test_slide_over_pane_finds_a_pane_beside_a_sideways_sash() -> None:
     np.testing.assert_allclose(draft.direction, [0.0, 1.0, 0.0], atol=1e-3)
 
 
-@pytest.mark.parametrize("case", ["drawer", "hinge", "no_pane"])
-def test_slide_over_pane_does_not_fire_without_a_sash_over_a_pane(case: str) -> None:
+def test_slide_over_pane_without_a_pane_turns_the_slide_onto_a_level_track() -> None:
+    """A sliding door alone in its frame has no pane behind it to point to; its track is still
+    level or plumb, and a slide 17 deg off level is turned onto it."""
+    points, labels = _sash(np.random.default_rng(0))
+    keep = ~((labels == 0) & (points[:, 0] > -0.18) & (points[:, 2] > 0.27))
+    draft = _draft(points[keep], labels[keep], _slide((0.0, 0.95, 0.3)))
+    assert SlideOverPane().refine(draft)
+    np.testing.assert_allclose(draft.direction, [0.0, 1.0, 0.0], atol=1e-3)
+
+
+@pytest.mark.parametrize("case", ["drawer", "hinge"])
+def test_slide_over_pane_does_not_fire_without_a_sash(case: str) -> None:
     rng = np.random.default_rng(0)
     if case == "drawer":  # slides out of its front: no sash
         points, labels = _drawer(rng)
         draft = _draft(points, labels, _slide((-1.0, 0.0, 0.0)))
-    elif case == "hinge":
+    else:
         points, labels = _door(rng)
         draft = _draft(points, labels, _hinge())
-    else:  # a sliding door alone in its frame: nothing behind it to slide over
-        points, labels = _sash(rng)
-        keep = ~((labels == 0) & (points[:, 0] > -0.18) & (points[:, 2] > 0.27))
-        draft = _draft(points[keep], labels[keep], _slide((0.0, 1.0, 0.0)))
     before = draft.direction.copy()
     assert not SlideOverPane().refine(draft)
     np.testing.assert_array_equal(draft.direction, before)
