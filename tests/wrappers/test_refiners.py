@@ -226,6 +226,40 @@ def test_handle_does_not_take_an_open_drawers_bottom_for_a_sliding_face() -> Non
     assert draft.face is None and not Handle().refine(draft)
 
 
+def test_a_sash_face_turns_towards_the_cameras_when_its_handle_and_plinth_stand_out_in_front() -> None:
+    """A thin window frame: the sash's bar and the plinth under it stand further out in front than
+    the frame and pane reach behind, so the away-from-the-body rule turns the sash's normal to the
+    back; seen from the cameras it faces them, and the handle is found off it."""
+    rng = np.random.default_rng(0)
+    sash = _box(rng, 500, -0.2, (-0.2, 0.2), (0.1, 0.3))
+    bar = _box(rng, 60, -0.27, (-0.05, 0.05), 0.13)
+    plinth = _box(rng, 600, (-0.32, -0.18), (-0.25, 0.25), 0.02)
+    pane = _box(rng, 150, -0.19, (-0.2, 0.2), (0.28, 0.5))
+    points = np.concatenate([sash, bar, plinth, pane]) + rng.normal(0.0, 0.001, (1310, 3))
+    labels = np.concatenate([np.ones(560, int), np.zeros(750, int)])
+    blind = _draft(points, labels, _slide((0.0, 0.0, 1.0)))
+    assert blind.sliding_face().outward[0] > 0.9  # turned to the back by the points in front
+    seen = _draft(points, labels, _slide((0.0, 0.0, 1.0)))
+    seen.viewpoint = np.array([-0.6, 0.0, 0.6])
+    assert seen.sliding_face().outward[0] < -0.9
+    assert Handle().refine(seen)
+    np.testing.assert_allclose(seen.grasp, [-0.27, 0.0, 0.13], atol=0.01)
+
+
+def test_the_viewpoint_is_the_cameras_mean_position() -> None:
+    from capt_env.wrappers.object_isolation import camera_viewpoint
+
+    def pose(x: float, y: float, z: float) -> np.ndarray:
+        m = np.eye(4)[None]
+        m[0, :3, 3] = (x, y, z)
+        return m
+
+    obs = {"sensor_param": {"left": {"cam2world_gl": pose(-0.4, 0.3, 0.7)},
+                            "right": {"cam2world_gl": pose(-0.4, -0.3, 0.5)}}}
+    np.testing.assert_allclose(camera_viewpoint(obs), [-0.4, 0.0, 0.6])
+    assert camera_viewpoint({"agent": {}}) is None
+
+
 # ---------------------------------------------------------------------------------- slide_over_pane
 @pytest.mark.parametrize("network", [(0.0, 1.0, 0.0), (0.0, -0.6, -0.8), (-0.3, 0.5, 0.8)])
 def test_slide_over_pane_turns_a_sash_up_over_the_pane_above_it(network: tuple[float, float, float]) -> None:

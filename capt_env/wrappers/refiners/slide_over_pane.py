@@ -35,13 +35,13 @@ from capt_env.wrappers.refiners.draft import Draft
 
 @dataclass(frozen=True)
 class SlideOverPaneConfig:
-    """Metres and radians: ``min_depth``..``max_depth`` how far behind the sash's face pane points
-    lie, counted in the densest ``slab`` thick layer parallel to the face, which must spread over
-    ``min_spread`` of the strip's length (a surface running back from the face, a plinth's top or a
-    cabinet's side, is a line in the face's plane); ``reach`` the longest
-    strip looked at beside the sash; ``across_share`` the share of the sash's width the strip spans
-    (its middle, clear of a frame's reveals); ``min_points`` and
-    ``dominance`` how many pane points the best side needs, alone and against the next side."""
+    """Metres: ``min_depth``..``max_depth`` how far behind the sash's face pane points lie, counted
+    in the densest ``slab`` thick layer parallel to the face, which must spread over ``min_spread`` of
+    the strip's length (a surface running back from the face, a plinth's top or a cabinet's side, is
+    a line in the face's plane); ``reach`` the longest strip looked at beside the sash;
+    ``across_share`` the share of the sash's width the strip spans (its middle, clear of a frame's
+    reveals); ``min_points`` and ``dominance`` how many pane points the best side needs, alone and
+    against the next side."""
 
     min_depth: float = 0.005
     max_depth: float = 0.05
