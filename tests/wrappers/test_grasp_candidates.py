@@ -215,3 +215,19 @@ def test_the_config_rejects_impossible_thresholds(bad: dict) -> None:
     GraspCandidateConfig().validate()
     with pytest.raises(ConfigError):
         GraspCandidateConfig(**bad).validate()
+
+
+def test_a_part_slides_across_an_upright_face_not_out_of_it_nor_along_a_floor() -> None:
+    from capt_env.wrappers.moving_part_geometry import PartPlane, faces_along, facing, slides_across
+
+    upright = PartPlane(np.zeros(3), np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), np.array([-1.0, 0.0, 0.0]))
+    floor = PartPlane(np.zeros(3), np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), np.array([0.0, 0.0, 1.0]))
+    for d in ([0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-0.3, 0.9, 0.0]):  # a sash: up, sideways, a bit out
+        assert slides_across(upright, np.array(d)) and not faces_along(upright, np.array(d))
+    assert faces_along(upright, np.array([-1.0, 0.0, 0.0]))
+    assert not slides_across(upright, np.array([-1.0, 0.0, 0.0]))  # a drawer
+    assert not slides_across(floor, np.array([1.0, 0.0, 0.0]))  # an open drawer's bottom
+    assert not slides_across(None, np.array([0.0, 0.0, 1.0]))
+    turned = facing(upright, np.array([1.0, 0.0, 0.5]))  # seen from behind: the normal turns round
+    np.testing.assert_allclose(turned.outward, [1.0, 0.0, 0.0])
+    assert facing(upright, np.array([-1.0, 0.0, 0.5])) is upright
