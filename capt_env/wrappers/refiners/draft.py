@@ -68,6 +68,8 @@ class Draft:
     fired: list[str] = field(default_factory=list)
     _plane: PartPlane | None = field(default=None, repr=False)
     _plane_known: bool = field(default=False, repr=False)
+    _sliding: PartPlane | None = field(default=None, repr=False)
+    _sliding_known: bool = field(default=False, repr=False)
     _settled: bool = field(default=False, repr=False)
 
     @property
@@ -93,10 +95,12 @@ class Draft:
         front of its pane is seen from its outer side; the away-from-the-body rule of
         :func:`part_plane` turns it round when a handle and a plinth standing out in front outweigh
         a thin frame behind), or as :func:`part_plane` orients it without a viewpoint."""
-        plane = part_plane(self.points, self.moving)
-        if plane is None or self.viewpoint is None:
-            return plane
-        return facing(plane, self.viewpoint)
+        if not self._sliding_known:  # fitted once per draft: the refiners and the handle ask again
+            plane = part_plane(self.points, self.moving)
+            if plane is not None and self.viewpoint is not None:
+                plane = facing(plane, self.viewpoint)
+            self._sliding, self._sliding_known = plane, True
+        return self._sliding
 
     def use_plane(self, plane: PartPlane | None) -> None:
         """Take ``plane`` as the moving part's plane (a stack's front for stacked drawers)."""
