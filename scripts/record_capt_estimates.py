@@ -34,10 +34,12 @@ def record(category: str, seeds: list[int], steps: int) -> list[dict[str, Any]]:
         calls[-1]["network"] = out
         return out
 
-    def recording_estimate(points: np.ndarray, info: dict, dense_points: np.ndarray | None = None) -> Any:
+    def recording_estimate(points: np.ndarray, info: dict, dense_points: np.ndarray | None = None,
+                           viewpoint: np.ndarray | None = None) -> Any:
         calls.append({"points": np.array(points), "dense": np.array(dense_points),
-                      "target": int(np.asarray(info["target_joint"]).reshape(-1)[0])})
-        calls[-1]["estimate"] = estimate(points, info, dense_points=dense_points)
+                      "target": int(np.asarray(info["target_joint"]).reshape(-1)[0]),
+                      "viewpoint": np.full(3, np.nan) if viewpoint is None else np.array(viewpoint)})
+        calls[-1]["estimate"] = estimate(points, info, dense_points=dense_points, viewpoint=viewpoint)
         return calls[-1]["estimate"]
 
     source.estimator.predict = recording_predict
@@ -71,6 +73,7 @@ def to_arrays(category: str, calls: list[dict[str, Any]]) -> dict[str, np.ndarra
             out[f"{key}/dense"] = dense.astype(np.float32)
         out |= {f"{key}/dense_call": owner, f"{key}/input": idx,
                 f"{key}/episode": np.array(c["episode"]), f"{key}/target": np.array(c["target"]),
+                f"{key}/viewpoint": c["viewpoint"],
                 f"{key}/labels": np.asarray(net.part_labels, dtype=np.int8),
                 f"{key}/joint_types": np.array([j.type for j in net.joints]),
                 f"{key}/joint_directions": np.array([j.direction for j in net.joints]),

@@ -255,9 +255,28 @@ class PrismaticPullConfig:
     """A slip from a part the hand has pulled past this (m) also ends the pull for good (0: off): the
     handle slid out at the end stop before the slowdown was read, and a re-grasp's approach would push
     the open part back in."""
+    track_fit_travel: float = 0.02
+    """Once the hand holding a sliding part has travelled this far (m), the line fitted to its path is
+    the line it pulls along (0: off): the part's track carries the hand along itself, so the path
+    measures the track, while an estimated slide a few degrees off it is pushed back by the track, the
+    hand's error off the commanded line grows every step and the pull slows until it reads as the end
+    stop or tears the handle out of the fingers."""
+    track_fit_max_turn: float = 0.8
+    """The fitted line within this (rad) of the estimated one. A single view can read a sash's slide
+    30-45 deg off its track and the track still carries the hand along itself; a hand sliding along a
+    bar handle across the pull (90 deg) is not the track."""
+    track_fit_max_rms: float = 0.004
+    """The path within this (m, RMS) of the line: a hand sliding along the handle is not."""
+    track_fit_max_gap_change: float = 0.002
+    """The hand's path counts until the finger gap changes by more than this (m) in one step: a bar
+    sliding out of the fingers narrows the gap by several millimetres a step (1.7 -> 1.2 -> 0.3 cm),
+    and the hand's path is then not the part's; a grip settling on its handle closes it by 1-2 mm a
+    step."""
 
     def validate(self) -> None:
-        _positive(self, "lead", "target", "stall_progress", "limit_min_speed_m", where="pull.prismatic.")
+        _positive(self, "lead", "target", "stall_progress", "limit_min_speed_m", "track_fit_max_turn",
+                  "track_fit_max_rms", "track_fit_max_gap_change", where="pull.prismatic.")
+        _non_negative(self, "track_fit_travel", where="pull.prismatic.", note=" m (0: off)")
         _at_least_one(self, "limit_window", where="pull.prismatic.")
         require(0.0 < self.limit_slowdown < 1.0,
                 f"pull.prismatic.limit_slowdown must be in (0, 1), got {self.limit_slowdown}")

@@ -61,11 +61,11 @@ def test_a_doors_path_gives_its_hinge_line() -> None:
     assert fit is not None and np.degrees(np.arccos(fit.direction @ axis)) < 3.0
 
 
-def _drawer_episode(motion_axis: bool) -> tuple[bool, float, ScriptedOpener]:
+def _drawer_episode(**options: object) -> tuple[bool, float, ScriptedOpener]:
     noise = {"model": "fixed_offset", "direction_rad": float(np.radians(10.0)), "pivot_m": 0.0,
              "state": 0.0, "grasp_m": 0.0}
     env = make_env("drawer_cabinet", {"source": "noisy_oracle", "every_k_steps": 5, "noise": noise})
-    opener = ScriptedOpener(with_options(ScriptedOpenerConfig(), pull__motion_axis__enabled=motion_axis))
+    opener = ScriptedOpener(with_options(ScriptedOpenerConfig(), **options))
     try:
         result = run_episode(env, opener, seed=0, max_steps=140)
     finally:
@@ -75,9 +75,17 @@ def _drawer_episode(motion_axis: bool) -> tuple[bool, float, ScriptedOpener]:
 
 def test_a_drawer_10_degrees_off_opens_once_its_motion_gives_the_axis() -> None:
     # pulled along the estimate, the drawer binds 8 cm out and the slowing hand reads as its end stop
-    opened, fraction, _ = _drawer_episode(motion_axis=False)
+    opened, fraction, _ = _drawer_episode(pull__prismatic__track_fit_travel=0.0)
     assert not opened and fraction < 0.5
-    opened, fraction, opener = _drawer_episode(motion_axis=True)
+    # the line the holding hand follows (on by default) ...
+    opened, fraction, opener = _drawer_episode()
+    line = opener.ctx.pull.line_fit
+    assert opened and fraction > 0.9 and line is not None
+    turn = np.degrees(np.arccos(np.clip(line @ opener.ctx.pull.grasp_u, -1.0, 1.0)))
+    assert turn == pytest.approx(10.0, abs=2.0)  # the estimate's error, measured by the hand
+    # ... or the path of the estimated grasp point (pull.motion_axis)
+    opened, fraction, opener = _drawer_episode(pull__prismatic__track_fit_travel=0.0,
+                                               pull__motion_axis__enabled=True)
     assert opened and fraction > 0.9
     motion = opener.ctx.axis.motion
     assert motion is not None and motion.turn == pytest.approx(np.radians(10.0), abs=0.01)

@@ -183,6 +183,45 @@ def test_a_sliding_panel_is_gripped_square_on_and_pulled_along_its_axis_either_w
     np.testing.assert_allclose(action[:3] * ACTION_SCALE_M, CFG.pull.prismatic.lead * direction, atol=1e-9)
 
 
+def _pull_along_track(cfg: ScriptedOpenerConfig, est: JointAxisEstimate, track: np.ndarray,
+                      travel: float, finger_gap: float = 0.02, gap_change: float = 0.0) -> np.ndarray:
+    """The commanded TCP step (m) after the hand, holding, was carried ``travel`` m along unit ``track``
+    in 8 steps, the finger gap going from ``finger_gap`` by ``gap_change`` (m) on the way."""
+    opener = ScriptedOpener(with_options(cfg, move__max_step_m=1.0))
+    opener.ctx.grasp.strategy = strategy_for(est, cfg, ROBOT_SIDE)
+    start = np.asarray(est.grasp_point, dtype=np.float64)
+    opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))
+    action = np.zeros(7)
+    for d, gap in zip(np.linspace(0.0, travel, 8), np.linspace(finger_gap, finger_gap + gap_change, 8),
+                      strict=True):
+        opener.ctx.now = Look(est, start + d * track, np.eye(3), float(gap), None)
+        action, _ = opener.current.step(opener.ctx)
+    return action[:3] * ACTION_SCALE_M
+
+
+def test_a_held_sliding_part_is_pulled_along_the_track_its_hand_follows_not_the_estimate() -> None:
+    # a sash on a level track (-y), estimated 14 deg up: the track carries the hand level
+    track = -Y
+    tilted = np.cos(np.radians(14.0)) * track + np.sin(np.radians(14.0)) * Z
+    est = _panel(tilted)
+    step = _pull_along_track(CFG, est, track, travel=0.06)
+    np.testing.assert_allclose(step / np.linalg.norm(step), track, atol=1e-6)
+    # before the hand has travelled track_fit_travel, or with the fit off, the estimate's line holds
+    # (the commanded step climbs back towards it: the error off it is what slows a pull into its end stop)
+    short = _pull_along_track(CFG, est, track, travel=0.015)
+    off = _pull_along_track(with_options(CFG, pull__prismatic__track_fit_travel=0.0), est, track, travel=0.06)
+    for step in (short, off):
+        assert step @ Z > 0.2 * np.linalg.norm(step)
+    # fingers that closed on nothing measure no track, nor do fingers a bar is sliding out of (the
+    # gap narrowing 2.3 mm a step); a grip settling on its handle (1 mm a step) still does
+    empty = _pull_along_track(CFG, est, track, travel=0.06, finger_gap=0.0)
+    slipping = _pull_along_track(CFG, est, track, travel=0.06, finger_gap=0.02, gap_change=-0.016)
+    for step in (empty, slipping):
+        assert step @ Z > 0.2 * np.linalg.norm(step)
+    settling = _pull_along_track(CFG, est, track, travel=0.06, finger_gap=0.036, gap_change=-0.007)
+    np.testing.assert_allclose(settling / np.linalg.norm(settling), track, atol=1e-6)
+
+
 @pytest.mark.parametrize(("option", "value", "kind", "answer"), [
     ("lid__target", 2.4, Lid, lambda s: s.pull_target(True)),
     ("lid__gap", 0.05, Lid, lambda s: s.gap),

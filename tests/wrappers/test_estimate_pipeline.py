@@ -47,7 +47,10 @@ def _calls(category: str) -> Iterator[tuple[int, Look, np.ndarray]]:
                 get("joint_confidences"), strict=True)))
         result = ArticulationEstimate(get("labels").astype(np.int64), joints, 0.0)
         points = dense[get("input").astype(np.int64)]
-        seen = Look(points, dense, int(get("target")), result, MODELS[category])
+        viewpoint = get("viewpoint").astype(np.float64) if f"{category}/{i}/viewpoint" in z.files else None
+        if viewpoint is not None and np.isnan(viewpoint).any():
+            viewpoint = None
+        seen = Look(points, dense, int(get("target")), result, MODELS[category], viewpoint)
         yield int(get("episode")), seen, get("estimate")
 
 
@@ -67,7 +70,7 @@ def _replay(source: CaptSource, category: str) -> Iterator[tuple[int, Look, Join
         source._estimator = SimpleNamespace(predict=lambda _p, r=seen.result: r,
                                             config=SimpleNamespace(model=seen.model))
         est = source.estimate(seen.points, {"target_joint": np.array([seen.target])},
-                              dense_points=seen.dense_points)
+                              dense_points=seen.dense_points, viewpoint=seen.viewpoint)
         yield ep, seen, est, recorded
 
 

@@ -231,3 +231,25 @@ def test_a_part_slides_across_an_upright_face_not_out_of_it_nor_along_a_floor() 
     turned = facing(upright, np.array([1.0, 0.0, 0.5]))  # seen from behind: the normal turns round
     np.testing.assert_allclose(turned.outward, [1.0, 0.0, 0.0])
     assert facing(upright, np.array([-1.0, 0.0, 0.5])) is upright
+
+
+def test_a_round_bar_on_long_posts_is_gripped_at_its_axis_not_at_its_seen_side() -> None:
+    # a 1.6 cm round bar along y, its axis 7 cm off the face on two posts (Meta-World's window bar),
+    # seen from level with it: the front 120 deg of its surface, and the posts
+    rng = np.random.default_rng(3)
+    radius, axis_at = 0.008, _at(0.07, 0.0, 0.2)
+    t, a = rng.uniform(-0.06, 0.06, 300), rng.uniform(-np.pi / 3.0, np.pi / 3.0, 300)
+    bar = axis_at + np.outer(t, Y) + radius * (np.outer(np.cos(a), OUT) + np.outer(np.sin(a), Z))
+    posts = np.concatenate([_at(0.0, y, 0.2) + np.outer(rng.uniform(0.0, 0.07, 30), OUT)
+                            + radius * rng.uniform(-1.0, 1.0, (30, 1)) * Z for y in (-0.045, 0.045)])
+    cloud, door = _scene(rng, bar, posts)
+    found = find_grasp_candidates(cloud, door)
+    assert found[0].kind == "bar"
+    assert abs(float((found[0].point - axis_at) @ OUT)) < 0.003  # half its thickness behind its front
+    # the centroid of the bar's outer points sits on the seen side, in front of the axis
+    from capt_env.wrappers.moving_part_geometry import PartPlane, bar_centre, outer_layer
+
+    plane = PartPlane(np.array([FACE_X, 0.0, 0.2]), np.array([Y, Z]), OUT)
+    out = cloud[((cloud - plane.centre) @ OUT > 0.01) & ((cloud - plane.centre) @ OUT < 0.15)]
+    centroid = bar_centre(out[outer_layer(out, plane)], OUT)
+    assert float((centroid - axis_at) @ OUT) > 0.004

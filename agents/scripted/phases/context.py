@@ -81,6 +81,13 @@ class PullTrack:
     """Those while the fingers held the part (for the arc fit)."""
     hinge_fit: np.ndarray | None = None
     """The hinge pivot (3,) m fitted to the held path (``pull.arc_fit``), kept for the pull."""
+    line_fit: np.ndarray | None = None
+    """The unit direction (3,) of the line fitted to the held path of a sliding part
+    (``pull.prismatic.track_fit_travel``), the latest accepted this pull."""
+    line_gap: float | None = None
+    """The finger gap (m) at the last step the hand held the sliding part this pull."""
+    line_slipped: bool = False
+    """The gap jumped (``pull.prismatic.track_fit_max_gap_change``): the hand's path no longer counts."""
     slip_count: int = 0
     """Steps running the hand has been off the grasp point with its fingers closed on nothing."""
     step_share: float = 1.0

@@ -45,6 +45,7 @@ def start_pull(ctx: OpenerContext, p: np.ndarray, r: np.ndarray, est: JointAxisE
     track.pulled = [p.copy()]
     track.held = [p.copy()]
     track.hinge_fit = None
+    track.line_fit, track.line_gap, track.line_slipped = None, None, False
     track.slip_count = 0
     track.step_share, track.last_q = 1.0, None
     # a hand lifting from below holds with closed fingers; unknown gaps count as holding
@@ -72,6 +73,8 @@ class Pull(OpenerPhase):
             # covered the part saw it best; later looks, the handle hidden, tilt it a few degrees,
             # and a hand pulling a few degrees off a sash's track slides off its bar
             u = track.grasp_u
+        if not revolute:
+            u = held_line(ctx, u, p, finger_gap)
         if cfg.pull.motion_axis.enabled:
             u = motion_axis(ctx, est, u, p, r, finger_gap, revolute)
         # while the hand holds the part, its own travel along the estimated arc or line measures the
@@ -270,6 +273,30 @@ def hinge_pivot(ctx: OpenerContext, u: np.ndarray, pivot: np.ndarray, p: np.ndar
     # kept for the rest of the pull: a hand that later slips off the handle leaves the arc
     track.hinge_fit = fit[0]
     return fit[0]
+
+
+def held_line(ctx: OpenerContext, u: np.ndarray, p: np.ndarray, finger_gap: float | None) -> np.ndarray:
+    """The unit direction (3,) to pull a sliding part along: the line fitted to the path of the hand
+    holding it (``p``, the TCP position (3,) m now, is added while the fingers hold) once it spans
+    ``pull.prismatic.track_fit_travel`` and fits (:func:`~agents.scripted.motion_axis.fit_motion_axis`),
+    signed like the estimated unit ``u``; before that, ``u``. The part's track carries the held hand
+    along itself, so the path measures the track however far off the estimate was. The path counts
+    until the finger gap jumps (``track_fit_max_gap_change``): the part slipping out of the fingers."""
+    cfg, track = ctx.cfg.pull.prismatic, ctx.pull
+    holding = finger_gap is not None and finger_gap >= ctx.cfg.grasp.hold_gap
+    if holding and finger_gap is not None:
+        if track.line_gap is not None and abs(finger_gap - track.line_gap) > cfg.track_fit_max_gap_change:
+            track.line_slipped = True
+        track.line_gap = finger_gap
+    if cfg.track_fit_travel > 0.0 and holding and not track.line_slipped:
+        track.held.append(p.copy())
+        fit = fit_motion_axis(np.asarray(track.held), u, p, False, cfg.track_fit_travel, 0.0,
+                              cfg.track_fit_max_rms, cfg.track_fit_max_turn)
+        if fit is not None:
+            track.line_fit = fit.direction
+    if track.line_fit is None:
+        return u
+    return track.line_fit if float(track.line_fit @ u) >= 0.0 else -track.line_fit
 
 
 def motion_axis(ctx: OpenerContext, est: JointAxisEstimate, u: np.ndarray, p: np.ndarray, r: np.ndarray,

@@ -8,8 +8,10 @@ fallback, the part's far edge, is a strip along the whole edge. The search runs 
 (:func:`~capt_env.wrappers.grasp_candidates.find_grasp_candidates`): points standing off the face are
 split into linked clusters, so two handles of a double door are two candidates, not one centroid
 between them, and stray points too few to be a handle, or a slab wider than a hand, are dropped. A
-bar is centred across its thickness too (the cameras see one side of it), except on a part swinging
-about a horizontal hinge (an oven door, a lid): measured, that moved an oven's grasp point off its bar.
+bar is centred across its thickness too (the cameras see one side of it), and its depth put half
+its thickness behind its front (the posts that hold it off the face pull a centroid behind it),
+except on a part swinging about a horizontal hinge (an oven door, a lid): measured, that moved an
+oven's grasp point off its bar.
 The face is the part's plane (:attr:`Draft.face`): a drawer's front, facing along its slide, or the
 upright face a sash or sliding door slides across.
 Must not fire: when a refiner already found the handle (``stacked_parts``), the part is not flat (or
