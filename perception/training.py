@@ -249,6 +249,12 @@ def train(config: TrainConfig, data_dir: str | Path | Sequence[str | Path], out_
     return TrainResult(best_path, last_path, log_path, best_val, window, epochs_run)
 
 
+def epoch_seconds(log_path: str | Path) -> list[float]:
+    """Wall seconds of each epoch in a run's ``log.csv`` (resumed epochs included), in epoch order."""
+    with open(log_path, newline="") as fh:
+        return [float(row["seconds"]) for row in csv.DictReader(fh)]
+
+
 def _append_log(path: Path, epoch: int, tr: dict[str, float], va: dict[str, float], lr: float,
                 seconds: float) -> None:
     header = ["epoch", *(f"train_{k}" for k in LOSS_NAMES), *(f"val_{k}" for k in LOSS_NAMES), "lr",

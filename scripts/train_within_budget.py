@@ -12,7 +12,6 @@ with PyTorch and PyYAML alone (a lent GPU).
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
 import platform
@@ -25,15 +24,9 @@ import torch
 
 from capt_common.typed_yaml import load_yaml
 from perception.config import TrainConfig
-from perception.training import train
+from perception.training import epoch_seconds, train
 
 RESERVE_S = 30.0  # the final voting-window search and checkpoint writes
-
-
-def epoch_seconds(log: Path) -> list[float]:
-    """The ``seconds`` column of a training log."""
-    with log.open() as fh:
-        return [float(row["seconds"]) for row in csv.DictReader(fh)]
 
 
 def main() -> None:

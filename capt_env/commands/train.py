@@ -79,7 +79,7 @@ def _check_fits_slots(category: str, structure: dict, model: dict) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from perception.training import train
+    from perception.training import epoch_seconds, train
 
     cfg, category = train_config_for(args.config, args.data, args.epochs, args.device, args.seed)
     result = train(cfg, args.data, args.out, resume=not args.no_resume, stop_after=args.stop_after,
@@ -97,9 +97,3 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def epoch_seconds(log_path: str | Path) -> list[float]:
-    """Wall seconds of each epoch in a run's ``log.csv`` (resumed epochs included), in epoch order."""
-    import csv
-
-    with open(log_path, newline="") as fh:
-        return [float(row["seconds"]) for row in csv.DictReader(fh)]

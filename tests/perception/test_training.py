@@ -7,7 +7,6 @@ from unittest import mock
 
 import pytest
 
-from capt_env.commands.train import epoch_seconds
 from perception.checkpoint import load_checkpoint
 from perception.config import CaptConfig, TrainConfig
 from perception.corruption import Corruption
@@ -15,7 +14,7 @@ from perception.data import write_dataset
 from perception.evaluation import evaluate
 from perception.inference import ArticulationEstimator
 from perception.outlier_filter import OutlierFilter
-from perception.training import train
+from perception.training import epoch_seconds, train
 
 from .helpers import make_samples, tiny_model_config
 
