@@ -174,7 +174,8 @@ def find_grasp_candidates(object_points: np.ndarray, part_points: np.ndarray, pl
     The edge candidate is on the face's edge farthest from the hinge (``hinge_direction`` (3,) through
     ``hinge_pivot`` (3,)) when one is given, else at the end of the face's longest in-plane axis farther
     from the object's centroid. With ``centre_across`` a bar's point is centred across its thickness
-    too (:func:`~capt_env.wrappers.moving_part_geometry.bar_centre`).
+    too (:func:`~capt_env.wrappers.moving_part_geometry.bar_centre`) and put half its thickness behind
+    its front (:func:`_bar_depth`).
     """
     c = config or GraspCandidateConfig()
     obj = np.asarray(object_points, dtype=np.float64)
