@@ -166,15 +166,15 @@ def _load_user_file(scene: Any, cfg: TaskConfig) -> LoadedObject:
     closed_qpos = np.where(closed_at_upper, sim_limits[:, 1], sim_limits[:, 0])
     _set_qpos(art, closed_qpos)
     warnings = list(info["warnings"])
-    part = joints[target].child_link
-    if cfg.part_mass is not None:
-        set_link_mass(part, cfg.part_mass)
-    elif float(part.mass.reshape(-1)[0]) < MIN_PART_MASS:
-        warnings.append(f"the moving part {part.name!r} weighs {float(part.mass.reshape(-1)[0]):.3g} kg; "
-                        f"set to {MIN_PART_MASS} kg (MIN_PART_MASS; part_mass sets it)")
-        set_link_mass(part, MIN_PART_MASS)
-    aabb = _articulation_aabb(art)
     grasp_link = joints[target].child_link
+    file_mass = float(grasp_link.mass.reshape(-1)[0])
+    if cfg.part_mass is not None:
+        set_link_mass(grasp_link, cfg.part_mass)
+    elif file_mass < MIN_PART_MASS:
+        warnings.append(f"the moving part {grasp_link.name!r} weighs {file_mass:.3g} kg; "
+                        f"set to {MIN_PART_MASS} kg (MIN_PART_MASS; part_mass sets it)")
+        set_link_mass(grasp_link, MIN_PART_MASS)
+    aabb = _articulation_aabb(art)
     grasp = _user_grasp_target(art, joints, target, type_ids[target], float(open_sign[target]), aabb, cfg)
     front = cfg.front_yaw_radians()
     if front is None:

@@ -78,7 +78,7 @@ class PullTrack:
     pulled: list[np.ndarray] = field(default_factory=list)
     """TCP positions (3,) m of this pull, every step."""
     held: list[np.ndarray] = field(default_factory=list)
-    """Those while the fingers held the part (for the arc fit)."""
+    """Those while the fingers held the part (for the arc fit of a hinge, the line fit of a slide)."""
     hinge_fit: np.ndarray | None = None
     """The hinge pivot (3,) m fitted to the held path (``pull.arc_fit``), kept for the pull."""
     line_fit: np.ndarray | None = None

@@ -68,13 +68,12 @@ class Pull(OpenerPhase):
             # the part opens the way it did when the pull began: a re-estimate that flips the axis
             # (the sign is what a single view gets wrong most) would read the opening as closing
             u = -u
-        if not revolute and track.grasp_u is not None:
-            # one line per pull: a slide's line is fixed in the world, and the look before the hand
-            # covered the part saw it best; later looks, the handle hidden, tilt it a few degrees,
-            # and a hand pulling a few degrees off a sash's track slides off its bar
-            u = track.grasp_u
         if not revolute:
-            u = held_line(ctx, u, p, finger_gap)
+            # one line per pull: a slide's line is fixed in the world, and the look before the hand
+            # covered the part saw it best (later looks, the handle hidden, tilt it a few degrees,
+            # and a hand pulling a few degrees off a sash's track slides off its bar), until the
+            # holding hand's own path measures it
+            u = held_line(ctx, u if track.grasp_u is None else track.grasp_u, p, finger_gap)
         if cfg.pull.motion_axis.enabled:
             u = motion_axis(ctx, est, u, p, r, finger_gap, revolute)
         # while the hand holds the part, its own travel along the estimated arc or line measures the

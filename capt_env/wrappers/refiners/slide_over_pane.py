@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from capt_common.typed_yaml import require
 from capt_env.wrappers.estimate import unit
@@ -102,8 +103,7 @@ def pane_side(points: np.ndarray, moving: np.ndarray, face: PartPlane,
     the whole cloud; world frame (+z up), metres."""
     c = config
     first, _, second, _ = track_directions(face)
-    moving_rows = {tuple(p) for p in np.round(moving, 9)}
-    others = points[[tuple(p) not in moving_rows for p in np.round(points, 9)]]
+    others = points[cKDTree(moving).query(points)[0] > 0.0]  # moving is a subset of points
     depth = (face.centre - others) @ face.outward  # > 0 behind the face
     behind = (depth >= c.min_depth) & (depth <= c.max_depth)
     others, depth = others[behind], depth[behind]
