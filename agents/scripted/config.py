@@ -370,10 +370,27 @@ class SideDoorConfig:
     """A hinge within this (rad) of vertical is a side door's."""
     pitch: float = 0.8
     """The approach points at least this far below horizontal (rad)."""
+    pull_roll: float = 0.8
+    """While pulling, past ``pull_roll_from``, the hand pitches further down by this share of the
+    further angle the door turns (rad per rad), turning about the horizontal axis across its
+    approach (the line between its fingertips, or the level bar they close across: the grip turns
+    about what it holds), up to ``max_pull_pitch``: a hand square to a door swung far round points
+    away from the robot, its wrist out beyond the door and the arm at the edge of its reach; pitched
+    down, the wrist stays over the handle. 0: off."""
+    max_pull_pitch: float = 1.2
+    """The roll stops at this pitch below horizontal (rad)."""
+    pull_roll_from: float = 1.0
+    """The roll starts once the door has turned this far (rad): nearer closed the arm has reach to
+    spare, and a hand square to the door holds its handle best (each turn of the hand moves the pads on
+    a handle gripped a centimetre off the TCP)."""
 
     def validate(self) -> None:
         _angle(self.max_tilt, "side_door.max_tilt")
         _angle(self.pitch, "side_door.pitch")
+        require(self.pull_roll >= 0.0, f"side_door.pull_roll must be >= 0 rad/rad, got {self.pull_roll}")
+        _angle(self.max_pull_pitch, "side_door.max_pull_pitch")
+        require(self.pull_roll_from >= 0.0,
+                f"side_door.pull_roll_from must be >= 0 rad, got {self.pull_roll_from}")
 
 
 @dataclass(frozen=True)
@@ -458,8 +475,8 @@ class FallingDoorConfig:
     """Let go past this angle (rad), the open hand clears the door's sweep and waits while it falls; a
     door let go nearer closed falls too slowly to wait for."""
     clearance: float = 0.1
-    """While waiting, the hand moves this far (m) beyond the grasp radius about the hinge (out of the
-    door's sweep)."""
+    """While waiting, and while turning in place before a grasp, the hand moves this far (m) beyond the
+    grasp radius about the hinge (out of the door's sweep)."""
     window: int = 10
     """The door is still falling while its perceived state rose by ``progress`` over this many steps."""
     progress: float = 0.06

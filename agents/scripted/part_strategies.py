@@ -160,6 +160,11 @@ class PartStrategy(ABC):
         """How far (m per radian turned) the pulling hand moves towards the hinge off the arc: 0."""
         return 0.0
 
+    def pull_rotation(self, r: np.ndarray, turned: float) -> np.ndarray:
+        """The pulling hand's rotation (3, 3) for ``r`` (3, 3), the grasp rotation turned with the part,
+        when the part has turned ``turned`` rad since the grasp: ``r``."""
+        return r
+
     def slip_offset(self, away: np.ndarray, u: np.ndarray) -> np.ndarray:
         """The part of the hand's offset ``away`` (3,) m from the perceived grasp point that counts
         towards a slip (``pull.slip_distance``), for the part's unit axis ``u`` (3,): all of it."""
@@ -196,6 +201,19 @@ class SideDoor(Hinged):
     @property
     def pitch(self) -> float:
         return self.own.pitch
+
+    def pull_rotation(self, r: np.ndarray, turned: float) -> np.ndarray:
+        """``r`` pitched down to ``side_door.pitch`` plus ``side_door.pull_roll`` times the angle
+        ``turned`` (rad) beyond ``side_door.pull_roll_from``, at most ``side_door.max_pull_pitch``,
+        about the horizontal axis across its approach (:func:`~agents.scripted.grasp_pose.
+        pitched_down`): a hand square to a door swung far round has its wrist out beyond the door,
+        where the arm runs out of reach. That axis is the line between the fingertips of a hand
+        closing level (across a vertical bar) and the bar of one closing across a level bar (a
+        lever): either way the grip turns about what it holds."""
+        beyond = turned - self.own.pull_roll_from
+        if self.own.pull_roll <= 0.0 or beyond <= 0.0:
+            return r
+        return pitched_down(r, min(self.own.pitch + self.own.pull_roll * beyond, self.own.max_pull_pitch))
 
 
 class FallingDoor(Hinged):

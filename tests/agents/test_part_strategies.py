@@ -10,7 +10,7 @@ import pytest
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
 from agents.scripted.config import with_options
 from agents.scripted.geometry import axis_angle_matrix
-from agents.scripted.grasp_pose import grasp_rotation, grasp_target, part_kind
+from agents.scripted.grasp_pose import grasp_rotation, grasp_target, part_kind, quarter_turn
 from agents.scripted.opener import ACTION_SCALE_M, Phase
 from agents.scripted.part_strategies import (
     STRATEGIES,
@@ -144,6 +144,35 @@ def test_a_side_door_is_pitched_further_and_the_hand_turns_fully_with_it() -> No
     assert door.pull_target(revolute=True) == CFG.pull.revolute.target and door.stall_can_be_end_stop
 
 
+def _elevation(v: np.ndarray) -> float:
+    return float(np.arcsin(np.clip(v[2], -1.0, 1.0)))
+
+
+def test_a_side_door_s_pull_pitches_the_hand_down_as_the_door_turns_about_what_it_holds() -> None:
+    door, own = SideDoor(CFG), CFG.side_door
+    grasp = door.grasp_rotation(_side_door(), np.eye(3))
+    np.testing.assert_allclose(door.pull_rotation(grasp, 0.0), grasp)
+    # nearer closed than pull_roll_from the hand stays square to the door
+    np.testing.assert_allclose(door.pull_rotation(grasp, 0.9 * own.pull_roll_from), grasp)
+    for turned in (0.6, 1.5, 4.0):
+        held = axis_angle_matrix(Z, turned) @ grasp
+        rolled = door.pull_rotation(held, turned)
+        want = min(own.pitch + own.pull_roll * max(turned - own.pull_roll_from, 0.0), own.max_pull_pitch)
+        assert _elevation(rolled[:, 2]) == pytest.approx(-want)
+        # fingers closing level (across a vertical bar) turn about the line between their tips
+        np.testing.assert_allclose(rolled[:, 1], held[:, 1], atol=1e-9)
+    # fingers turned a quarter to close across a level bar (a lever) turn about the bar
+    lever = quarter_turn(grasp, grasp)
+    rolled = door.pull_rotation(lever, 1.5)
+    np.testing.assert_allclose(rolled[:, 0], lever[:, 0], atol=1e-9)
+    assert _elevation(rolled[:, 2]) < _elevation(lever[:, 2]) - 0.3
+    # off, and no other kind of part rolls its hand
+    off = SideDoor(with_options(CFG, side_door__pull_roll=0.0))
+    np.testing.assert_allclose(off.pull_rotation(grasp, 1.5), grasp)
+    for other in (Hinged, Lid, FallingDoor, Drawer):
+        np.testing.assert_allclose(other(CFG).pull_rotation(grasp, 1.5), grasp)
+
+
 def test_a_door_that_falls_open_is_grasped_as_any_hinge_and_said_to_fall() -> None:
     oven, flap = strategy_for(_oven(), CFG), strategy_for(_flap(), CFG)
     assert oven.falls_open and not flap.falls_open
@@ -152,6 +181,23 @@ def test_a_door_that_falls_open_is_grasped_as_any_hinge_and_said_to_fall() -> No
     assert oven.pitch == flap.pitch == CFG.approach.pitch
     assert oven.hand_turn(_oven(), lifting=False) == CFG.pull.revolute.wrist_follow
     assert oven.own is CFG.falling_door
+
+
+def test_a_hand_turning_in_a_falling_door_s_sweep_moves_out_of_it_first() -> None:
+    # the hand pointing down 14 cm from an oven door's hinge (its handle 25 cm out): turning in place
+    # there, it knocks a door that then falls onto the arm
+    down_at = np.array([0.0, 0.0, 0.2, 0.0, 1.0, 0.0, 0.0])
+    radial = down_at[:3] - np.array([0.1, 0.0, 0.1])  # from the hinge line (along y) to the hand
+    opener = ScriptedOpener()
+    step = opener.act_on(_oven(), down_at)[:3]
+    assert opener.phase == Phase.PREGRASP and isinstance(opener.ctx.grasp.strategy, FallingDoor)
+    assert float(step @ radial) > 0.9 * np.linalg.norm(step) * np.linalg.norm(radial) > 0.0
+    # clear of the sweep (or a door that does not fall, or the rule off), it turns where it is
+    outside = np.array([-0.3, 0.0, 0.4, 0.0, 1.0, 0.0, 0.0])
+    for est, pose, cfg in ((_oven(), outside, CFG), (_side_door(), down_at, CFG),
+                           (_oven(), down_at, with_options(CFG, falling_door__done_above=0.0))):
+        action = ScriptedOpener(cfg).act_on(est, pose)
+        assert np.allclose(action[:3], 0.0) and not np.allclose(action[3:6], 0.0)
 
 
 def test_a_drawer_is_approached_along_its_axis_pitched_drawer_pitch() -> None:

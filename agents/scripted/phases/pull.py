@@ -181,7 +181,9 @@ def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u:
               pivot: np.ndarray, state: float, revolute: bool) -> tuple[np.ndarray, np.ndarray]:
     """The TCP goal (position (3,), rotation (3, 3)) of a pull step: the grasp pose moved with the part
     to ``state + lead``, rotated about unit axis ``u`` through ``pivot`` (moved towards it by the
-    strategy ``grip``'s inward slide; the hand turned by its share) or shifted along ``u``."""
+    strategy ``grip``'s inward slide; the hand turned by its share and
+    then by the strategy's :meth:`~agents.scripted.part_strategies.PartStrategy.pull_rotation`) or
+    shifted along ``u``."""
     cfg, track = ctx.cfg, ctx.pull
     assert track.grasp_p is not None and track.grasp_r is not None
     if not revolute:
@@ -198,7 +200,8 @@ def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u:
         if radius > 1e-6:
             p_des = p_des - min(inward * max(delta, 0.0), 0.5 * radius) * radial / radius
     follow = grip.hand_turn(est, ctx.lift)
-    return p_des, axis_angle_matrix(u, follow * delta) @ track.grasp_r
+    turned = state - track.grasp_state
+    return p_des, grip.pull_rotation(axis_angle_matrix(u, follow * delta) @ track.grasp_r, turned)
 
 
 def record_grip(ctx: OpenerContext, holding: bool, unknown: bool) -> None:

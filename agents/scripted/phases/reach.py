@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.scripted.geometry import axis_angle_matrix
+from agents.scripted.geometry import axis_angle_matrix, off_axis
 from agents.scripted.grasp_pose import SWAP_FINGERS, quarter_turn
 from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
 from agents.scripted.panda_kinematics import base_in_world, pose_matrix
@@ -67,8 +67,13 @@ class _Reach(OpenerPhase):
         if (self.phase == Phase.PREGRASP and rerr > cfg.approach.rotate_first_above
                 and ctx.phase_steps <= cfg.approach.rotate_first_steps):
             # turn the hand where it is first: turned while travelling, the IK ends low and far
-            # with the wrist at its limit, from where it cannot hold the grasp pose
-            action[:3] = 0.0
+            # with the wrist at its limit, from where it cannot hold the grasp pose; in a door's
+            # sweep that falls open, turn while moving out of it
+            clear = out_of_fall_sweep(ctx, est, p)
+            if clear is None:
+                action[:3] = 0.0
+            else:
+                action, _, _ = goto(ctx, p, r, clear, choice.target_r, gripper)
             return action, self
         if reached(ctx, p, perr, rerr):
             return action, self.next(ctx, est)
@@ -225,6 +230,25 @@ def grasp_point_moved(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
         float(np.linalg.norm(q - recent[-1])) <= cfg.rechoose_grasp_m for q in recent)
 
 
+def out_of_fall_sweep(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray) -> np.ndarray | None:
+    """Where the hand turning in place at TCP position ``p`` (3,) should move to instead: for a grasp
+    on a door that falls open (:attr:`~agents.scripted.part_strategies.PartStrategy.falls_open`), the
+    point ``falling_door.clearance`` beyond the grasp radius about the estimated hinge, straight out
+    from it, when ``p`` is nearer the hinge than that (None otherwise: turn in place). The robot's rest
+    pose can put the hand against such a door's handle: turning there knocks the door, which falls onto
+    the arm."""
+    cfg = ctx.cfg.falling_door
+    if cfg.done_above <= 0.0 or not ctx.grip(est).falls_open:
+        return None
+    u = unit(est.direction)
+    radial = off_axis(p - est.pivot, u)
+    radius = float(np.linalg.norm(radial))
+    clear = float(np.linalg.norm(off_axis(ctx.grip(est).grasp_target(est) - est.pivot, u))) + cfg.clearance
+    if radius < 1e-6 or radius >= clear:
+        return None
+    return p + (clear - radius) * radial / radius
+
+
 def part_kind_changed(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
     """Whether, with ``approach.rechoose_part_kind``, ``est`` shows a part grasped otherwise (another
     ``grasp_kind`` of :func:`~agents.scripted.part_strategies.strategy_for`) than the grasp's strategy,
@@ -258,7 +282,8 @@ def falling_on_its_own(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
 def rehearse_grasp(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimate, p: np.ndarray,
                    r: np.ndarray, arm_qpos: np.ndarray, rotation: np.ndarray) -> Rehearsal:
     """Grasp and pull with TCP ``rotation`` (3, 3) rehearsed on the arm's kinematic model, the pull
-    to ``kind``'s target, the hand turning as ``kind`` turns it."""
+    to ``kind``'s target, the hand turning (and rolling, :meth:`~agents.scripted.part_strategies.
+    PartStrategy.pull_rotation`) as ``kind`` turns it."""
     cfg = ctx.cfg
     approach = rotation[:, 2]
     point = est.grasp_point
@@ -271,7 +296,7 @@ def rehearse_grasp(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimat
         follow = kind.hand_turn(est, lifting=False)
         for delta in np.arange(0.05, max(target - float(est.state), 0.0) + 1e-9, 0.05):
             path.append((est.pivot + axis_angle_matrix(u, delta) @ (grasp_at - est.pivot),
-                         axis_angle_matrix(u, follow * delta) @ rotation))
+                         kind.pull_rotation(axis_angle_matrix(u, follow * delta) @ rotation, delta)))
     else:
         for delta in np.arange(0.01, max(target - float(est.state), 0.0) + 1e-9, 0.01):
             path.append((grasp_at + u * delta, rotation))
