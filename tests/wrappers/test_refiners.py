@@ -214,6 +214,29 @@ def test_handle_grasps_the_bar_on_a_sash_sliding_up_across_its_face() -> None:
     np.testing.assert_allclose(draft.grasp, [-0.25, 0.0, 0.13], atol=0.01)
 
 
+def test_a_sliding_part_s_handle_is_on_the_part_not_a_frame_bar_beside_it() -> None:
+    """A sash slides in a frame: a bar standing off beside it (the frame's, in the search margin and
+    scored higher: longer) is not its handle; the knob on the sash is. A door's lever may overhang
+    its free edge: the same geometry, hinged, keeps the bar."""
+    rng = np.random.default_rng(0)
+    sash = _box(rng, 500, -0.2, (-0.2, 0.2), (0.1, 0.3))
+    knob = _box(rng, 30, (-0.24, -0.23), (-0.01, 0.01), (0.19, 0.21))
+    frame_bar = _box(rng, 80, -0.24, 0.26, (0.05, 0.35))  # 6 cm beside the sash's edge (y = 0.2)
+    body = _box(rng, 400, (-0.15, 0.2), (-0.3, 0.3), 0.55)
+    points = np.concatenate([sash, knob, frame_bar, body]) + rng.normal(0.0, 0.001, (1010, 3))
+    labels = np.concatenate([np.ones(500, int), np.zeros(510, int)])
+    slide = _draft(points, labels, _slide((0.0, 1.0, 0.0)))
+    assert Handle().refine(slide) and slide.grasp is not None
+    np.testing.assert_allclose(slide.grasp[1:], [0.0, 0.2], atol=0.015)
+    door = _draft(points, labels, _hinge())
+    assert Handle().refine(door) and door.grasp is not None
+    assert door.grasp[1] > 0.24  # the longer bar, beyond the edge
+    # with no handle over the sliding part, its own fallback stands
+    bare = np.concatenate([sash, frame_bar, body]) + rng.normal(0.0, 0.001, (980, 3))
+    nothing = _draft(bare, np.concatenate([np.ones(500, int), np.zeros(480, int)]), _slide((0.0, 1.0, 0.0)))
+    assert not Handle().refine(nothing) and nothing.grasp is None
+
+
 def test_handle_does_not_take_an_open_drawers_bottom_for_a_sliding_face() -> None:
     """An open drawer's bottom holds its slide too, but looks up: its sides are no handles."""
     rng = np.random.default_rng(0)

@@ -1,7 +1,8 @@
 """Refiner ``handle``: the grasp point is the handle standing off the moving part's face.
 
 Geometric reason: a handle is the part of a door, drawer front or lid that stands furthest out of
-its flat face, 1.2-8 cm (``min_standoff``..``max_standoff``), within the face's extent; the network's
+its flat face, 1.2-8 cm (``min_standoff``..``max_standoff``), within the face's extent (a sliding
+part's within its own extent: beyond its edge it would catch the frame it slides in); the network's
 fallback, the part's far edge, is a strip along the whole edge. The search runs on the draft's
 ``handle_cloud`` (all object points: a segmentation may miss thin handle points) against the
 ``panel``'s plane and extent, and takes the best-scored bar or knob among the grasp candidates
@@ -25,8 +26,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
+import numpy as np
+
 from capt_common.typed_yaml import require
 from capt_env.wrappers.grasp_candidates import GraspCandidateConfig, find_grasp_candidates
+from capt_env.wrappers.moving_part_geometry import PartPlane
 from capt_env.wrappers.refiners.draft import Draft
 
 
@@ -34,18 +38,21 @@ from capt_env.wrappers.refiners.draft import Draft
 class HandleConfig:
     """``min_standoff``..``max_standoff`` (m): how far out of the face handle points stand;
     ``margin`` (m): the face's in-plane extent is grown by it; ``vertical_hinge_min_z``: a hinge whose
-    unit direction has at least this |z| counts as vertical (its handle is centred across the bar)."""
+    unit direction has at least this |z| counts as vertical (its handle is centred across the bar);
+    ``slide_margin`` (m): a sliding part's handle lies within its own extent grown by this."""
 
     min_standoff: float = 0.012
     max_standoff: float = 0.08
     margin: float = 0.1
     vertical_hinge_min_z: float = 0.5
+    slide_margin: float = 0.01
 
     def validate(self) -> None:
         require(0.0 <= self.min_standoff < self.max_standoff,
                 "handle.min_standoff must be >= 0 and below handle.max_standoff (metres)")
         require(self.margin >= 0, "handle.margin must be >= 0 (metres)")
         require(0.0 <= self.vertical_hinge_min_z <= 1.0, "handle.vertical_hinge_min_z must be in [0, 1]")
+        require(self.slide_margin >= 0, "handle.slide_margin must be >= 0 (metres)")
 
 
 class Handle:
@@ -67,7 +74,20 @@ class Handle:
             config=GraspCandidateConfig(min_standoff=c.min_standoff, max_standoff=c.max_standoff,
                                         margin=c.margin, min_points=draft.handle_min_points))
         handles = [g for g in found if g.kind in ("bar", "knob")]
+        if draft.joint_type == "prismatic":
+            # a sliding part carries its handle within its own face: one standing beyond its edge
+            # would run into the frame or track it slides in (a bar beside a sash is the frame's, or a
+            # plinth's). A hinged part's handle may overhang its free edge (a lever), swinging clear
+            handles = [g for g in handles if over_part(g.point, draft.panel, face, c.slide_margin)]
         if not handles:
             return False
         draft.grasp, draft.from_handle = handles[0].point, True
         return True
+
+
+def over_part(point: np.ndarray, part_points: np.ndarray, plane: PartPlane, margin: float) -> bool:
+    """Whether ``point`` (3,) lies over the part ``part_points`` (M, 3) seen along ``plane``'s normal:
+    inside the part's in-plane extent grown by ``margin`` (m). World frame, metres."""
+    uv = (np.asarray(point, dtype=np.float64) - plane.centre) @ plane.in_plane.T
+    part_uv = (np.asarray(part_points, dtype=np.float64) - plane.centre) @ plane.in_plane.T
+    return bool(np.all(uv >= part_uv.min(axis=0) - margin) and np.all(uv <= part_uv.max(axis=0) + margin))
