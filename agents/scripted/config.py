@@ -475,7 +475,7 @@ class FallingDoorConfig:
     """Let go past this angle (rad), the open hand clears the door's sweep and waits while it falls; a
     door let go nearer closed falls too slowly to wait for."""
     clearance: float = 0.1
-    """While waiting, and while turning in place before a grasp, the hand moves this far (m) beyond the
+    """While waiting, and before turning in place for a grasp, the hand moves this far (m) beyond the
     grasp radius about the hinge (out of the door's sweep)."""
     window: int = 10
     """The door is still falling while its perceived state rose by ``progress`` over this many steps."""

@@ -67,13 +67,13 @@ class _Reach(OpenerPhase):
         if (self.phase == Phase.PREGRASP and rerr > cfg.approach.rotate_first_above
                 and ctx.phase_steps <= cfg.approach.rotate_first_steps):
             # turn the hand where it is first: turned while travelling, the IK ends low and far
-            # with the wrist at its limit, from where it cannot hold the grasp pose; in a door's
-            # sweep that falls open, turn while moving out of it
+            # with the wrist at its limit, from where it cannot hold the grasp pose; in the sweep of
+            # a door that falls open, move out of it first, unturned
             clear = out_of_fall_sweep(ctx, est, p)
             if clear is None:
                 action[:3] = 0.0
             else:
-                action, _, _ = goto(ctx, p, r, clear, choice.target_r, gripper)
+                action, _, _ = goto(ctx, p, r, clear, r, gripper)
             return action, self
         if reached(ctx, p, perr, rerr):
             return action, self.next(ctx, est)
@@ -231,10 +231,12 @@ def grasp_point_moved(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
 
 
 def out_of_fall_sweep(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray) -> np.ndarray | None:
-    """Where the hand turning in place at TCP position ``p`` (3,) should move to instead: for a grasp
+    """Where the hand about to turn in place at TCP position ``p`` (3,) should move to first, unturned:
+    for a grasp
     on a door that falls open (:attr:`~agents.scripted.part_strategies.PartStrategy.falls_open`), the
     point ``falling_door.clearance`` beyond the grasp radius about the estimated hinge, straight out
-    from it, when ``p`` is nearer the hinge than that (None otherwise: turn in place). The robot's rest
+    from it, when ``p`` is nearer the hinge than that by more than ``move.pos_tolerance`` (None
+    otherwise: turn in place). The robot's rest
     pose can put the hand against such a door's handle: turning there knocks the door, which falls onto
     the arm."""
     cfg = ctx.cfg.falling_door
@@ -244,7 +246,7 @@ def out_of_fall_sweep(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray)
     radial = off_axis(p - est.pivot, u)
     radius = float(np.linalg.norm(radial))
     clear = float(np.linalg.norm(off_axis(ctx.grip(est).grasp_target(est) - est.pivot, u))) + cfg.clearance
-    if radius < 1e-6 or radius >= clear:
+    if radius < 1e-6 or radius >= clear - ctx.cfg.move.pos_tolerance:
         return None
     return p + (clear - radius) * radial / radius
 
