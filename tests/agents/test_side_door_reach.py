@@ -23,7 +23,7 @@ BASE = np.array([-0.615, 0.0, 0.0])
 # a door hinged at its far left (seen from the robot), opening towards the robot; its handle 37 cm
 # from the hinge and 12 cm off the door's face (a lever on its post)
 HINGE = np.array([0.318, 0.177, 0.151])
-UP_AXIS = np.array([0.0, 0.0, -1.0])  # +state opens
+HINGE_AXIS = np.array([0.0, 0.0, -1.0])  # pointing down: +state opens the door towards the robot
 HANDLE = np.array([0.128, -0.144, 0.151])
 SUCCESS_ANGLE = 1.5  # 0.75 of the door's 2 rad range
 
@@ -32,7 +32,7 @@ def _pull_error(cfg: ScriptedOpenerConfig, angle: float, quarter: bool) -> float
     """How far (m) the TCP ends from the pull's goal with the door at ``angle`` rad, the arm having
     followed the pull from the grasp in 0.05 rad steps, three controller steps each."""
     door = SideDoor(cfg)
-    est = JointAxisEstimate("revolute", UP_AXIS, HINGE, 0.0, HANDLE)
+    est = JointAxisEstimate("revolute", HINGE_AXIS, HINGE, 0.0, HANDLE)
     r0 = door.grasp_rotation(est, tcp_pose(REST)[:3, :3])
     if quarter:
         r0 = quarter_turn(r0, r0)
@@ -43,7 +43,7 @@ def _pull_error(cfg: ScriptedOpenerConfig, angle: float, quarter: bool) -> float
             q = ik_step(q, pose_matrix(start[:3, 3] + share * (HANDLE - BASE - start[:3, 3]), r0))
     err = np.zeros(6)
     for turned in np.arange(0.05, angle + 1e-9, 0.05):
-        turn = axis_angle_matrix(UP_AXIS, turned)
+        turn = axis_angle_matrix(HINGE_AXIS, turned)
         goal = pose_matrix(HINGE + turn @ (HANDLE - HINGE) - BASE, door.pull_rotation(turn @ r0, turned))
         for _ in range(3):
             q = ik_step(q, goal)

@@ -232,13 +232,11 @@ def grasp_point_moved(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
 
 def out_of_fall_sweep(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray) -> np.ndarray | None:
     """Where the hand about to turn in place at TCP position ``p`` (3,) should move to first, unturned:
-    for a grasp
-    on a door that falls open (:attr:`~agents.scripted.part_strategies.PartStrategy.falls_open`), the
-    point ``falling_door.clearance`` beyond the grasp radius about the estimated hinge, straight out
-    from it, when ``p`` is nearer the hinge than that by more than ``move.pos_tolerance`` (None
-    otherwise: turn in place). The robot's rest
-    pose can put the hand against such a door's handle: turning there knocks the door, which falls onto
-    the arm."""
+    for a grasp on a door that falls open (:attr:`~agents.scripted.part_strategies.PartStrategy.
+    falls_open`), the point ``falling_door.clearance`` beyond the grasp radius about the estimated
+    hinge, straight out from it, when ``p`` is nearer the hinge than that by more than
+    ``move.pos_tolerance`` (None otherwise: turn in place). The robot's rest pose can put the hand
+    against such a door's handle: turning there knocks the door, which falls onto the arm."""
     cfg = ctx.cfg.falling_door
     if cfg.done_above <= 0.0 or not ctx.grip(est).falls_open:
         return None
