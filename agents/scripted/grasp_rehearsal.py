@@ -77,15 +77,18 @@ def rehearse(arm_qpos: np.ndarray, tcp_in_world: np.ndarray, rotation: np.ndarra
              *, max_step_m: float, max_step_rad: float, rotate_first_above: float,
              rotate_first_steps: int, move_timeout: int, pos_tolerance: float, rot_tolerance: float,
              pull_tolerance_m: float = 0.02, pull_tolerance_rad: float = 0.25,
-             steps_per_waypoint: int = 2) -> Rehearsal:
+             steps_per_waypoint: int = 2, clear_at: np.ndarray | None = None) -> Rehearsal:
     """Rehearse turning the hand to ``rotation`` (3, 3), moving to the ``pregrasp`` and ``grasp``
     positions (3,), then following ``pull_path`` (world (position, rotation) waypoints from the grasp
     out, ``steps_per_waypoint`` control steps each), from the arm's joint angles ``arm_qpos`` (7,) rad
     and its TCP pose ``tcp_in_world`` (4, 4). The caps, tolerances and timeouts are the opener's. A
     waypoint is followed when the TCP ends within ``pull_tolerance_m`` m and ``pull_tolerance_rad`` rad
     of it: a hand turned 0.25 rad (15 deg) off the way the part turns twists a bar held across the
-    finger pads towards their edge, where it slips out as the lag grows."""
+    finger pads towards their edge, where it slips out as the lag grows. With ``clear_at`` (3,) the
+    hand first moves there unturned (out of a falling door's sweep) and turns there."""
     arm = _Arm(arm_qpos, tcp_in_world, max_step_m, max_step_rad)
+    if clear_at is not None:
+        arm.move(pose_matrix(clear_at, tcp_in_world[:3, :3]), move_timeout, pos_tolerance, rot_tolerance)
     pregrasp_goal = pose_matrix(pregrasp, rotation)
     for _ in range(rotate_first_steps):
         if arm.error(pregrasp_goal)[1] <= rotate_first_above:

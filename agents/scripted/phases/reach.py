@@ -69,7 +69,7 @@ class _Reach(OpenerPhase):
             # turn the hand where it is first: turned while travelling, the IK ends low and far
             # with the wrist at its limit, from where it cannot hold the grasp pose; in the sweep of
             # a door that falls open, move out of it first, unturned
-            clear = out_of_fall_sweep(ctx, est, p)
+            clear = out_of_fall_sweep(ctx, ctx.grip(est), est, p)
             if clear is None:
                 action[:3] = 0.0
             else:
@@ -230,20 +230,22 @@ def grasp_point_moved(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
         float(np.linalg.norm(q - recent[-1])) <= cfg.rechoose_grasp_m for q in recent)
 
 
-def out_of_fall_sweep(ctx: OpenerContext, est: JointAxisEstimate, p: np.ndarray) -> np.ndarray | None:
+def out_of_fall_sweep(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimate,
+                      p: np.ndarray) -> np.ndarray | None:
     """Where the hand about to turn in place at TCP position ``p`` (3,) should move to first, unturned:
-    for a grasp on a door that falls open (:attr:`~agents.scripted.part_strategies.PartStrategy.
-    falls_open`), the point ``falling_door.clearance`` beyond the grasp radius about the estimated
-    hinge, straight out from it, when ``p`` is nearer the hinge than that by more than
-    ``move.pos_tolerance`` (None otherwise: turn in place). The robot's rest pose can put the hand
-    against such a door's handle: turning there knocks the door, which falls onto the arm."""
+    for a grasp of strategy ``kind`` on a door that falls open
+    (:attr:`~agents.scripted.part_strategies.PartStrategy.falls_open`), the point
+    ``falling_door.clearance`` beyond the grasp radius about the estimated hinge, straight out from it,
+    when ``p`` is nearer the hinge than that by more than ``move.pos_tolerance`` (None otherwise: turn
+    in place). The robot's rest pose can put the hand against such a door's handle: turning there
+    knocks the door, which falls onto the arm."""
     cfg = ctx.cfg.falling_door
-    if cfg.done_above <= 0.0 or not ctx.grip(est).falls_open:
+    if cfg.done_above <= 0.0 or not kind.falls_open:
         return None
     u = unit(est.direction)
     radial = off_axis(p - est.pivot, u)
     radius = float(np.linalg.norm(radial))
-    clear = float(np.linalg.norm(off_axis(ctx.grip(est).grasp_target(est) - est.pivot, u))) + cfg.clearance
+    clear = float(np.linalg.norm(off_axis(kind.grasp_target(est) - est.pivot, u))) + cfg.clearance
     if radius < 1e-6 or radius >= clear - ctx.cfg.move.pos_tolerance:
         return None
     return p + (clear - radius) * radial / radius
@@ -283,7 +285,8 @@ def rehearse_grasp(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimat
                    r: np.ndarray, arm_qpos: np.ndarray, rotation: np.ndarray) -> Rehearsal:
     """Grasp and pull with TCP ``rotation`` (3, 3) rehearsed on the arm's kinematic model, the pull
     to ``kind``'s target, the hand turning (and rolling, :meth:`~agents.scripted.part_strategies.
-    PartStrategy.pull_rotation`) as ``kind`` turns it."""
+    PartStrategy.pull_rotation`) as ``kind`` turns it; first out of a falling door's sweep, as the
+    pre-grasp moves (:func:`out_of_fall_sweep`)."""
     cfg = ctx.cfg
     approach = rotation[:, 2]
     point = est.grasp_point
@@ -303,6 +306,7 @@ def rehearse_grasp(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimat
     pregrasp_at = point - approach * cfg.approach.pregrasp_offset
     move = cfg.move
     return rehearse(arm_qpos, pose_matrix(p, r), rotation, pregrasp_at, grasp_at, path,
+                    clear_at=out_of_fall_sweep(ctx, kind, est, p),
                     max_step_m=move.max_step_m, max_step_rad=move.max_step_rad,
                     rotate_first_above=cfg.approach.rotate_first_above,
                     rotate_first_steps=cfg.approach.rotate_first_steps, move_timeout=move.timeout_steps,
