@@ -45,6 +45,19 @@ def off_axis(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
     return v - float(v @ axis) * axis
 
 
+def out_of_sweep(p: np.ndarray, axis: np.ndarray, pivot: np.ndarray, reach: np.ndarray,
+                 clearance: float) -> np.ndarray | None:
+    """The point straight out from the line along unit ``axis`` (3,) through ``pivot`` (3,), from ``p``
+    (3,), ``clearance`` (m) beyond the radius of ``reach`` (3,) about that line (the sweep of a part
+    turning about it); ``p`` itself when already that far out, None when ``p`` is on the line."""
+    radial = off_axis(np.asarray(p, dtype=np.float64) - pivot, axis)
+    radius = float(np.linalg.norm(radial))
+    if radius < 1e-6:
+        return None
+    clear = float(np.linalg.norm(off_axis(np.asarray(reach, dtype=np.float64) - pivot, axis))) + clearance
+    return p + max(clear - radius, 0.0) * radial / radius
+
+
 def swept_angle(axis: np.ndarray, pivot: np.ndarray, start: np.ndarray, now: np.ndarray) -> float:
     """Signed angle (radians, right-handed about unit ``axis``) that carries point ``start`` (3,) to
     point ``now`` (3,) about the line through ``pivot`` (3,); components along the axis are ignored.

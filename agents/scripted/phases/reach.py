@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.scripted.geometry import axis_angle_matrix, off_axis
+from agents.scripted.geometry import axis_angle_matrix, out_of_sweep
 from agents.scripted.grasp_pose import SWAP_FINGERS, quarter_turn
 from agents.scripted.grasp_rehearsal import Rehearsal, rehearse
 from agents.scripted.panda_kinematics import base_in_world, pose_matrix
@@ -242,13 +242,10 @@ def out_of_fall_sweep(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEsti
     cfg = ctx.cfg.falling_door
     if cfg.done_above <= 0.0 or not kind.falls_open:
         return None
-    u = unit(est.direction)
-    radial = off_axis(p - est.pivot, u)
-    radius = float(np.linalg.norm(radial))
-    clear = float(np.linalg.norm(off_axis(kind.grasp_target(est) - est.pivot, u))) + cfg.clearance
-    if radius < 1e-6 or radius >= clear - ctx.cfg.move.pos_tolerance:
+    goal = out_of_sweep(p, unit(est.direction), est.pivot, kind.grasp_target(est), cfg.clearance)
+    if goal is None or float(np.linalg.norm(goal - p)) <= ctx.cfg.move.pos_tolerance:
         return None
-    return p + (clear - radius) * radial / radius
+    return goal
 
 
 def part_kind_changed(ctx: OpenerContext, est: JointAxisEstimate) -> bool:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from agents.scripted.geometry import off_axis
+from agents.scripted.geometry import out_of_sweep
 from agents.scripted.phases import reach
 from agents.scripted.phases.base import GRIPPER_CLOSE, GRIPPER_OPEN, OpenerPhase, Phase, goto, hold, reached
 from agents.scripted.phases.context import OpenerContext
@@ -73,14 +73,8 @@ class WaitForFall(OpenerPhase):
         cfg, look = ctx.cfg.falling_door, ctx.now
         assert look is not None and ctx.settle is not None and ctx.pull.grasp_p is not None
         est, p, r = look.est, look.p, look.r
-        u = unit(est.direction)
-        radial = off_axis(p - est.pivot, u)
-        radius = float(np.linalg.norm(radial))
-        goal = p
-        if radius > 1e-6:
-            clear = float(np.linalg.norm(off_axis(ctx.pull.grasp_p - est.pivot, u))) + cfg.clearance
-            goal = p + max(clear - radius, 0.0) * radial / radius
-        action, _, _ = goto(ctx, p, r, goal, r, GRIPPER_OPEN)
+        goal = out_of_sweep(p, unit(est.direction), est.pivot, ctx.pull.grasp_p, cfg.clearance)
+        action, _, _ = goto(ctx, p, r, p if goal is None else goal, r, GRIPPER_OPEN)
         ctx.settle.append(float(est.state))
         states = ctx.settle
         rising = len(states) <= cfg.window or risen(ctx, states)
