@@ -1,5 +1,6 @@
 """Trace one scripted-opener episode step by step: phase, TCP, finger gap, the estimate and the part's
-true state, for finding which situation an opening fails in (development seeds only).
+true state, and the estimate's errors against the truth (direction in degrees, axis line and grasp
+point in cm), for finding which situation an opening fails in (development seeds only).
 
     python scripts/trace_opener_episode.py --objects data/real_objects/corpus.yaml --name mw_window \
         --seed 100 --every 5 --json /tmp/trace.json
@@ -16,11 +17,13 @@ import numpy as np
 
 from agents.scripted import ScriptedOpener
 from agents.scripted.geometry import quat_to_matrix
+from capt_env.commands.estimate_errors import estimate_errors
 from capt_env.commands.object_targets import load_objects_yaml, target_task
 from capt_env.commands.rollout import opener_config
 from capt_env.commands.task_overrides import task_overrides
 from capt_env.env_factory import make_env
 from capt_env.wrappers.joint_observation import decode_observation
+from capt_env.wrappers.perception_sources import ground_truth_estimate
 
 
 def main() -> None:
@@ -61,6 +64,7 @@ def main() -> None:
         qpos = np.asarray(proprio["qpos"], dtype=np.float64).reshape(-1)
         tcp = np.asarray(proprio["tcp_pose"], dtype=np.float64)
         action = opener.act(obs, info)
+        err = estimate_errors(est, ground_truth_estimate(info))
         if step == 1:
             approach = opener.ctx.grasp.target_r[:, 2] if opener.ctx.grasp.target_r is not None else None
             print(f"joint {est.joint_type} axis {np.round(est.direction, 3)} pivot {np.round(est.pivot, 3)} "
@@ -76,12 +80,15 @@ def main() -> None:
                "action": np.round(action, 2).tolist(),
                "approach": np.round(quat_to_matrix(tcp[3:7])[:, 2], 3).tolist(),
                "closing": np.round(quat_to_matrix(tcp[3:7])[:, 1], 3).tolist(),
-               "arm": np.round(qpos[:7], 2).tolist()}
+               "arm": np.round(qpos[:7], 2).tolist(),
+               "error": {"direction_deg": round(err["direction_deg"], 1),
+                         "line_cm": None if err["line_m"] is None else round(100 * err["line_m"], 1),
+                         "grasp_cm": round(100 * err["grasp_m"], 1)}}
         steps.append(row)
         if opener.phase.value != last_phase or step % args.every == 0:
             print(f"{step:4d} {row['phase']:9s} tcp {row['tcp']} gap {row['gap']:.4f} "
                   f"state {row['state']:+.3f} open {row['open_fraction']:.2f} ok {int(row['success'])} "
-                  f"grasp {row['grasp']} "
+                  f"grasp {row['grasp']} err {row['error']} "
                   f"act {row['action']} appr {row['approach']} clos {row['closing']} arm {row['arm']}")
             if opener.phase.value == "approach" and last_phase != "approach":
                 print("     rehearsals (nearer, other):", opener.rehearsals)
