@@ -353,9 +353,15 @@ class RecoveryConfig:
     wrist_limit_margin: float = 0.05
     """A wrist joint (5, 6, 7) within this (rad) of its limit is at it (0: off). A pull that stalls so
     grasps again with the fingers the other way round: the arm ran out of range with this order."""
+    unmoved: float = 0.03
+    """A pull whose hand slips off while the part's grasp point as seen has moved less than this (m)
+    since the pull began held nothing it could pull (the fingers pinched the end of a lever lying
+    along their closing direction, not the bar across it): the next grasp turns the fingers as after
+    fingers that closed on nothing (0: never)."""
 
     def validate(self) -> None:
         require(self.max_regrasps >= 0, "recovery.max_regrasps must be >= 0")
+        require(self.unmoved >= 0.0, f"recovery.unmoved must be >= 0 m, got {self.unmoved}")
         require(0.0 <= self.wrist_limit_margin < 0.5,
                 f"recovery.wrist_limit_margin must be in [0, 0.5) rad (0: off), "
                 f"got {self.wrist_limit_margin}")

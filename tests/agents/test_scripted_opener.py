@@ -1042,3 +1042,42 @@ def test_a_lid_grasp_point_sliding_along_the_lip_between_looks_does_not_drag_the
     plain = ScriptedOpener(_cfg(lid__along_slack=0.0))
     plain.act_on(est, _pose(np.eye(3), np.array([-0.1, 0.09, 0.2])))
     assert plain.current.goal(plain.ctx, est)[0][1] == pytest.approx(0.05)
+
+
+def _side_door_hand_ran_off(door_follows: bool, cfg: ScriptedOpenerConfig) -> ScriptedOpener:
+    """An opener pulling a closed door on a vertical hinge whose fingers read empty from the first
+    step while the hand runs round the arc; the door (its grasp point as seen) follows the hand
+    (``door_follows``: the grip held, then slid off) or stays shut, until the pull ends."""
+    u, pivot = np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3])
+    closed = JointAxisEstimate("revolute", u, pivot, 0.0, np.array([-0.1, 0.2, 0.3]))
+    rot = grasp_rotation(closed, np.eye(3), cfg)
+    opener = ScriptedOpener(cfg)
+    opener.act_on(closed, _pose(rot, closed.grasp_point))
+    opener.enter(start_pull(opener.ctx, closed.grasp_point, rot, closed, "closed"))
+    for k in range(1, 40):
+        turn = axis_angle_matrix(u, 0.03 * k)
+        hand = pivot + turn @ (closed.grasp_point - pivot)
+        seen = closed
+        if door_follows:  # the door a little behind the hand, as a grip sliding off leaves it
+            seen = JointAxisEstimate("revolute", u, pivot, 0.02 * k,
+                                     pivot + axis_angle_matrix(u, 0.02 * k) @ (closed.grasp_point - pivot))
+        opener.act_on(seen, _pose(turn @ rot, hand), finger_gap=0.0)
+        if opener.phase != Phase.PULL:
+            return opener
+    raise AssertionError("the pull did not end")
+
+
+def test_a_hand_that_ran_off_a_part_that_stayed_put_grasps_again_turned() -> None:
+    # a Meta-World lever door with ground truth: the fingers, closing along the lever, pinched its end
+    # and the hand ran off round the arc with the door shut; grasped the same way again they met the
+    # lever's end again, and the quarter turn came one empty grasp later, too late in the episode
+    cfg = ScriptedOpenerConfig()
+    still = _side_door_hand_ran_off(door_follows=False, cfg=cfg)
+    assert still.phase == Phase.PREGRASP and still.phase_log[-1]["why"] == "slip"
+    assert still.ctx.grasp.quarter and still.regrasps == 1
+    # a part that moved with the hand before the grip slid off was held: the same grasp again
+    moved = _side_door_hand_ran_off(door_follows=True, cfg=cfg)
+    assert moved.phase == Phase.PREGRASP and not moved.ctx.grasp.quarter and not moved.ctx.grasp.other_fingers
+    # recovery.unmoved 0: never turned
+    off = _side_door_hand_ran_off(door_follows=False, cfg=_cfg(recovery__unmoved=0.0))
+    assert off.phase == Phase.PREGRASP and not off.ctx.grasp.quarter

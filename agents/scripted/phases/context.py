@@ -70,6 +70,8 @@ class PullTrack:
     grasp_pivot: np.ndarray | None = None
     """The estimated pivot (3,) m when the pull began: the arc's centre until the part's own motion
     measures one (``pull.arc_fit``, ``pull.motion_axis``)."""
+    grasp_seen: np.ndarray | None = None
+    """The perceived grasp point (3,) m when the pull began."""
     grasp_u: np.ndarray | None = None
     """Unit axis (3,) the part opened along when the pull began (a re-estimate that flips it is turned
     back)."""

@@ -17,7 +17,7 @@ class Close(OpenerPhase):
     phase = Phase.CLOSE
 
     def step(self, ctx: OpenerContext) -> tuple[np.ndarray, OpenerPhase]:
-        cfg, look, choice = ctx.cfg, ctx.now, ctx.grasp
+        cfg, look = ctx.cfg, ctx.now
         assert look is not None
         action = hold(GRIPPER_CLOSE)
         if ctx.phase_steps < cfg.grasp.close_steps:
@@ -40,14 +40,23 @@ class Close(OpenerPhase):
             # the fingers (a lever or bar at right angles to the one expected): a quarter turn on
             ctx.regrasps += 1
             ctx.grasp_again = True
-            short = ctx.move.reach_why == "timeout" or wrist_at_limit(
-                look.arm_qpos, cfg.recovery.wrist_limit_margin)
-            if not cfg.recovery.quarter_turn or short:
-                choice.other_fingers = True
-            else:
-                choice.quarter = not choice.quarter
+            turn_fingers(ctx, look.arm_qpos)
             return action, release.Release("empty", gap=round(gap, 4))
         started = pull.start_pull(ctx, look.p, look.r, look.est, "empty" if empty else "closed")
         if gap is not None:
             started.log_extra["gap"] = round(gap, 4)
         return action, started
+
+
+def turn_fingers(ctx: OpenerContext, arm_qpos: np.ndarray | None) -> None:
+    """Turn the next grasp's fingers after one that held nothing it could pull (``arm_qpos`` (7,) rad
+    or None: the arm now). If the approach timed out or a wrist joint is at its limit, the arm stopped
+    short of the handle (a low handle can put one there in one of the two finger orders): the fingers
+    the other way round. Otherwise the hand was at the handle, which does not lie across the fingers (a
+    lever or bar at right angles to the one expected): a quarter turn on (``recovery.quarter_turn``)."""
+    cfg, choice = ctx.cfg, ctx.grasp
+    short = ctx.move.reach_why == "timeout" or wrist_at_limit(arm_qpos, cfg.recovery.wrist_limit_margin)
+    if not cfg.recovery.quarter_turn or short:
+        choice.other_fingers = True
+    else:
+        choice.quarter = not choice.quarter

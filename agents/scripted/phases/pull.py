@@ -15,7 +15,7 @@ import numpy as np
 from agents.scripted.geometry import axis_angle_matrix, fit_circle, off_axis, swept_angle
 from agents.scripted.motion_axis import fit_motion_axis
 from agents.scripted.part_strategies import PartStrategy, strategy_for
-from agents.scripted.phases import reach, release
+from agents.scripted.phases import grasp, reach, release
 from agents.scripted.phases.base import (
     GRIPPER_CLOSE,
     GRIPPER_OPEN,
@@ -40,6 +40,7 @@ def start_pull(ctx: OpenerContext, p: np.ndarray, r: np.ndarray, est: JointAxisE
     track.grasp_state = 0.0 if first else est.state
     track.grasp_u = unit(est.direction)
     track.grasp_pivot = np.asarray(est.pivot, dtype=np.float64).copy()
+    track.grasp_seen = np.asarray(est.grasp_point, dtype=np.float64).copy()
     track.falls = strategy_for(est, ctx.cfg).falls_open
     track.history = []
     track.pulled = [p.copy()]
@@ -154,11 +155,24 @@ class Pull(OpenerPhase):
         if slipped and ctx.regrasps < cfg.recovery.max_regrasps:
             ctx.regrasps += 1
             ctx.grasp.target_r = None
+            if unmoved(ctx, est) and grip.turns_fingers_on_miss and cfg.recovery.other_fingers:
+                # the hand ran off while the part stayed put: the fingers held the end of a bar lying
+                # along them, not the bar; grasp again turned, as after fingers closed on nothing
+                grasp.turn_fingers(ctx, arm_qpos)
             return hold(GRIPPER_OPEN), reach.pregrasp(ctx, "slip")
         p_des, r_des = pull_pose(ctx, grip, est, u, pivot, state, revolute)
         action, _, _ = goto(ctx, p, r, p_des, r_des, GRIPPER_CLOSE)
         action[:6] *= step_share(ctx, arm_qpos)
         return action, self
+
+
+def unmoved(ctx: OpenerContext, est: JointAxisEstimate) -> bool:
+    """Whether the part's grasp point as seen in ``est`` lies within ``recovery.unmoved`` m of where it
+    was seen when the pull began (0: never)."""
+    limit, seen = ctx.cfg.recovery.unmoved, ctx.pull.grasp_seen
+    if limit <= 0.0 or seen is None:
+        return False
+    return float(np.linalg.norm(np.asarray(est.grasp_point, dtype=np.float64) - seen)) < limit
 
 
 def step_share(ctx: OpenerContext, arm_qpos: np.ndarray | None) -> float:
