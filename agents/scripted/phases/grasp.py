@@ -33,11 +33,7 @@ class Close(OpenerPhase):
         if (grip.turns_fingers_on_miss and cfg.recovery.other_fingers and empty
                 and ctx.regrasps < cfg.recovery.max_regrasps):
             assert gap is not None
-            # the fingers closed on nothing: back off and grasp again. If the approach timed out or a
-            # wrist joint is at its limit, the arm stopped short of the handle (a low handle can put
-            # one there in one of the two finger orders): the fingers the other way round. Otherwise
-            # the hand is at the handle (there, or stopped by touching it), which does not lie across
-            # the fingers (a lever or bar at right angles to the one expected): a quarter turn on
+            # the fingers closed on nothing: back off and grasp again, the fingers turned
             ctx.regrasps += 1
             ctx.grasp_again = True
             turn_fingers(ctx, look.arm_qpos)
@@ -52,8 +48,9 @@ def turn_fingers(ctx: OpenerContext, arm_qpos: np.ndarray | None) -> None:
     """Turn the next grasp's fingers after one that held nothing it could pull (``arm_qpos`` (7,) rad
     or None: the arm now). If the approach timed out or a wrist joint is at its limit, the arm stopped
     short of the handle (a low handle can put one there in one of the two finger orders): the fingers
-    the other way round. Otherwise the hand was at the handle, which does not lie across the fingers (a
-    lever or bar at right angles to the one expected): a quarter turn on (``recovery.quarter_turn``)."""
+    the other way round. Otherwise the hand was at the handle (there, or stopped by touching it), which
+    does not lie across the fingers (a lever or bar at right angles to the one expected): a quarter
+    turn on (``recovery.quarter_turn``)."""
     cfg, choice = ctx.cfg, ctx.grasp
     short = ctx.move.reach_why == "timeout" or wrist_at_limit(arm_qpos, cfg.recovery.wrist_limit_margin)
     if not cfg.recovery.quarter_turn or short:
