@@ -546,16 +546,23 @@ def test_a_door_seen_falling_open_before_its_grasp_is_waited_for_not_reached_for
     assert side.phase != Phase.RETREAT and side.ctx.settle is None
 
 
-def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: float) -> ScriptedOpener:
+def _side_door_pull_begun(cfg: ScriptedOpenerConfig) -> tuple[ScriptedOpener, JointAxisEstimate, np.ndarray]:
     """An opener that grasped a closed door on a vertical hinge (+z at y = -0.2 m, handle 0.4 m
-    from it, opening towards -x) and whose hand, fingers ``finger_gap`` m apart, stopped with the
-    door ``state`` rad open."""
+    from it, opening towards -x) and began its pull; the door's estimate and the grasp rotation."""
     u, pivot = np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3])
     closed = JointAxisEstimate("revolute", u, pivot, 0.0, np.array([-0.1, 0.2, 0.3]))
     rot = grasp_rotation(closed, np.eye(3), cfg)
     opener = ScriptedOpener(cfg)
     opener.act_on(closed, _pose(rot, closed.grasp_point))
     opener.enter(start_pull(opener.ctx, closed.grasp_point, rot, closed, "closed"))
+    return opener, closed, rot
+
+
+def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: float) -> ScriptedOpener:
+    """An opener that grasped a closed door on a vertical hinge (:func:`_side_door_pull_begun`) and
+    whose hand, fingers ``finger_gap`` m apart, stopped with the door ``state`` rad open."""
+    opener, closed, rot = _side_door_pull_begun(cfg)
+    u, pivot = closed.direction, closed.pivot
     turn = axis_angle_matrix(u, state)
     est = JointAxisEstimate("revolute", u, pivot, state, pivot + turn @ (closed.grasp_point - pivot))
     at = _pose(turn @ rot, est.grasp_point)
@@ -1045,15 +1052,12 @@ def test_a_lid_grasp_point_sliding_along_the_lip_between_looks_does_not_drag_the
 
 
 def _side_door_hand_ran_off(door_follows: bool, cfg: ScriptedOpenerConfig) -> ScriptedOpener:
-    """An opener pulling a closed door on a vertical hinge whose fingers read empty from the first
-    step while the hand runs round the arc; the door (its grasp point as seen) follows the hand
-    (``door_follows``: the grip held, then slid off) or stays shut, until the pull ends."""
-    u, pivot = np.array([0.0, 0.0, 1.0]), np.array([-0.1, -0.2, 0.3])
-    closed = JointAxisEstimate("revolute", u, pivot, 0.0, np.array([-0.1, 0.2, 0.3]))
-    rot = grasp_rotation(closed, np.eye(3), cfg)
-    opener = ScriptedOpener(cfg)
-    opener.act_on(closed, _pose(rot, closed.grasp_point))
-    opener.enter(start_pull(opener.ctx, closed.grasp_point, rot, closed, "closed"))
+    """An opener pulling a closed door on a vertical hinge (:func:`_side_door_pull_begun`) whose
+    fingers read empty from the first step while the hand runs round the arc; the door (its grasp
+    point as seen) follows the hand (``door_follows``: the grip held, then slid off) or stays shut,
+    until the pull ends."""
+    opener, closed, rot = _side_door_pull_begun(cfg)
+    u, pivot = closed.direction, closed.pivot
     for k in range(1, 40):
         turn = axis_angle_matrix(u, 0.03 * k)
         hand = pivot + turn @ (closed.grasp_point - pivot)
