@@ -420,6 +420,16 @@ class LidLiftConfig:
     """The hand moves this far (m) towards the hinge per radian the lid has turned: on an estimated hinge
     1-2 cm off, fingertips following its arc slide off the lip; sliding towards the hinge they stay
     under it."""
+    press: float = 0.01
+    """The hand is sent at least this far (m) towards the hinge from where it is now, and at most twice
+    as far inside the ``inward`` arc: a hinge estimated a centimetre off moves that arc away from the
+    lid's front face, and fingertips no longer pressed into it ride up over its corner."""
+    slip_behind: float = 0.3
+    """Lifting, the hand has slipped off the lid only while the lid as perceived also lags the hand's
+    own measure of it by more than this (rad; 0: the grasp point alone decides): the closed fingers
+    tell no gap, and a look that reads a half-open lid's hinge at its lip, or its far edge mid-lid,
+    moves the perceived grasp point far from a hand still under the lid, while the perceived angle
+    (the network's state) stays with the lid."""
     lead: float = 0.2
     """The push leads the lid by this angle (rad): pushing from below, the fingertips carry its weight,
     and a larger lead pushes through the stall near 0.4 rad that ``pull.revolute.lead`` meets."""
@@ -427,7 +437,7 @@ class LidLiftConfig:
     def validate(self) -> None:
         _positive(self, "lead", where="lid.lift.")
         require(0.0 < self.pitch <= 1.5, f"lid.lift.pitch must be in (0, 1.5] rad, got {self.pitch}")
-        _non_negative(self, "below", "front", "under", "inward", where="lid.lift.", note=" m")
+        _non_negative(self, "below", "front", "under", "inward", "press", "slip_behind", where="lid.lift.", note=" m")
         _share(self, "wrist_follow", where="lid.lift.")
 
 

@@ -160,6 +160,15 @@ class PartStrategy(ABC):
         """How far (m per radian turned) the pulling hand moves towards the hinge off the arc: 0."""
         return 0.0
 
+    def press(self, lifting: bool) -> float:
+        """How far (m) the pulling hand is sent towards the hinge from where it is: 0."""
+        return 0.0
+
+    def slip_behind(self, lifting: bool) -> float:
+        """How far (rad) the perceived part must lag the hand's measure for a slip as well: 0 (the
+        grasp point alone decides)."""
+        return 0.0
+
     def pull_rotation(self, r: np.ndarray, turned: float) -> np.ndarray:
         """The pulling hand's rotation (3, 3) for ``r`` (3, 3), the grasp rotation turned with the part,
         when the part has turned ``turned`` rad since the grasp: ``r``."""
@@ -313,6 +322,16 @@ class Lid(Hinged):
         """``lid.lift.inward`` while lifting: on an estimated hinge 1-2 cm off, fingertips following
         its arc slide off the lip; sliding towards the hinge they stay under it."""
         return self.own.lift.inward if lifting else 0.0
+
+    def press(self, lifting: bool) -> float:
+        """``lid.lift.press`` while lifting: the fingertips stay pressed into the lid's front face
+        whatever the estimated hinge's error."""
+        return self.own.lift.press if lifting else 0.0
+
+    def slip_behind(self, lifting: bool) -> float:
+        """``lid.lift.slip_behind`` while lifting: the perceived angle, not the grasp point, tells a
+        hand that ran on from a lid it no longer carries."""
+        return self.own.lift.slip_behind if lifting else 0.0
 
     def slip_offset(self, away: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Without the part along the hinge (``lid.slip_off_axis``): a lid has no handle, and its grasp

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 import capt_env  # noqa: F401
 from agents.scripted import ScriptedOpener, ScriptedOpenerConfig
 from agents.scripted.config import LEGACY_KEYS, legacy_value, with_options
-from agents.scripted.geometry import axis_angle_matrix, fit_circle, swept_angle
+from agents.scripted.geometry import axis_angle_matrix, fit_circle, off_axis, swept_angle
 from agents.scripted.grasp_pose import (
     falls_open,
     grasp_rotation,
@@ -27,7 +27,7 @@ from agents.scripted.opener import ACTION_SCALE_M, Phase
 from agents.scripted.panda_kinematics import tcp_pose
 from agents.scripted.phases.base import Look
 from agents.scripted.phases.grasp import Close
-from agents.scripted.phases.pull import start_pull
+from agents.scripted.phases.pull import pressed, start_pull
 from agents.scripted.rollout import run_episode
 from capt_common.typed_yaml import ConfigError, from_dict
 from capt_env.env_factory import make_env
@@ -115,7 +115,7 @@ def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_
     def commanded(inward: float) -> np.ndarray:
         """The TCP translation (m) the opener commands from ``now``, lifting with ``inward``."""
         opener = ScriptedOpener(_cfg(lid__lift__inward=inward, lid__lift__lead=0.12,
-                                                     move__max_step_m=1.0))
+                                     lid__lift__press=0.0, move__max_step_m=1.0))
         opener.ctx.grasp.lid = opener.ctx.lift = True
         opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))
         return _pull_step(opener, est, now, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
@@ -128,16 +128,18 @@ def test_a_lid_lifted_from_below_is_pushed_along_an_arc_that_slides_towards_the_
     np.testing.assert_allclose(inward - plain, -0.02 * 0.62 * radial / np.linalg.norm(radial), atol=1e-6)
 
 
-def _lid_pull_after(seen_offset: np.ndarray, cfg: ScriptedOpenerConfig) -> ScriptedOpener:
-    """An opener lifting the closed laptop's lid from below, held 0.5 rad open for ``slip_steps`` + 2
-    steps while the perceived grasp point sits ``seen_offset`` (3,) m from the hand."""
+def _lid_pull_after(seen_offset: np.ndarray, cfg: ScriptedOpenerConfig,
+                    seen_state: float = 0.5) -> ScriptedOpener:
+    """An opener lifting the closed laptop's lid from below, the hand held 0.5 rad up its arc for
+    ``slip_steps`` + 2 steps while the perceived grasp point sits ``seen_offset`` (3,) m from the
+    hand and the lid is perceived ``seen_state`` rad open."""
     est = _closed_laptop()
     start = est.grasp_point - np.array([0.0, 0.0, 0.01])
     now = est.pivot + axis_angle_matrix(est.direction, 0.5) @ (start - est.pivot)
     opener = ScriptedOpener(cfg)
     opener.ctx.grasp.lid = opener.ctx.lift = True
     opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))
-    seen = JointAxisEstimate("revolute", est.direction, est.pivot, 0.5, now + seen_offset)
+    seen = JointAxisEstimate("revolute", est.direction, est.pivot, seen_state, now + seen_offset)
     for _ in range(cfg.pull.slip_steps + 2):
         opener.act_on(seen, _pose(np.eye(3), now), finger_gap=0.0)
     return opener
@@ -148,11 +150,53 @@ def test_a_lid_grasp_point_sliding_along_the_hinge_is_not_a_slip() -> None:
     # point 11-13 cm along the hinge from the hand mid-pull, and the re-grasps ran out the episode
     along = np.array([0.0, 0.12, 0.0])
     assert _lid_pull_after(along, ScriptedOpenerConfig()).phase == Phase.PULL
-    off = _lid_pull_after(along, _cfg(lid__slip_off_axis=False))
+    off = _lid_pull_after(along, _cfg(lid__slip_off_axis=False, lid__lift__slip_behind=0.0))
     assert off.phase == Phase.PREGRASP and off.regrasps == 1
-    # off the lid's arc (the lid fell back under the hand) is a slip either way
-    below = _lid_pull_after(np.array([0.0, 0.0, -0.12]), ScriptedOpenerConfig())
+    # off the lid's arc (the lid fell back under the hand, seen closed) is a slip either way
+    below = _lid_pull_after(np.array([0.0, 0.0, -0.12]), ScriptedOpenerConfig(), seen_state=0.0)
     assert below.phase == Phase.PREGRASP and below.regrasps == 1
+
+
+def test_a_look_that_puts_a_half_open_lids_grasp_point_mid_lid_is_not_a_slip() -> None:
+    # lifting from below, a look that reads the half-open lid's hinge at its lip, or takes its far
+    # edge for a point mid-lid, moves the perceived grasp point 15 cm from the hand carrying the lid;
+    # the perceived angle stays with the lid
+    mid_lid = np.array([0.15, 0.0, -0.02])
+    cfg = ScriptedOpenerConfig()
+    assert _lid_pull_after(mid_lid, cfg, seen_state=0.45).phase == Phase.PULL
+    # the lid seen well behind the hand's measure of it: the hand ran on without it
+    behind = _lid_pull_after(mid_lid, cfg, seen_state=0.5 - cfg.lid.lift.slip_behind - 0.05)
+    assert behind.phase == Phase.PREGRASP and behind.regrasps == 1
+    # without the rule the grasp point alone decides
+    assert _lid_pull_after(mid_lid, _cfg(lid__lift__slip_behind=0.0), seen_state=0.45).phase == Phase.PREGRASP
+
+
+def test_a_lid_lifted_on_an_arc_that_runs_off_its_front_face_stays_pressed_into_it() -> None:
+    # a hinge estimated a centimetre off turns the estimated arc away from the lid's front face, and a
+    # hand following it rides up over the face's corner; the hand is sent press m nearer the hinge
+    # than it is, so it stays pressed into the face wherever the arc runs
+    est = _closed_laptop()
+    u = est.direction
+    start = est.grasp_point - np.array([0.0, 0.0, 0.01])
+    on_arc = est.pivot + axis_angle_matrix(u, 0.5) @ (start - est.pivot)
+    radius = float(np.linalg.norm(off_axis(start - est.pivot, u)))
+
+    def goal_radius(hand: np.ndarray, press: float) -> float:
+        cfg = _cfg(lid__lift__inward=0.0, lid__lift__press=press, move__max_step_m=1.0)
+        opener = ScriptedOpener(cfg)
+        opener.ctx.grasp.lid = opener.ctx.lift = True
+        opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))
+        goal = hand + _pull_step(opener, est, hand, np.eye(3), finger_gap=0.0)[:3] * ACTION_SCALE_M
+        return float(np.linalg.norm(off_axis(goal - est.pivot, u)))
+
+    assert goal_radius(on_arc, 0.0) == pytest.approx(radius, abs=1e-6)  # the arc alone
+    assert goal_radius(on_arc, 0.01) == pytest.approx(radius - 0.01, abs=1e-6)
+    # a hand held out beyond the arc: the arc is already far enough inside it
+    beyond = on_arc + 0.015 * unit(off_axis(on_arc - est.pivot, u))
+    assert goal_radius(beyond, 0.01) == pytest.approx(radius, abs=1e-6)
+    # never more than twice the press inside the arc, however far in the hand is
+    np.testing.assert_allclose(pressed(start, start + np.array([0.1, 0, 0]), est.pivot, u, 0.01),
+                               start + 0.02 * unit(off_axis(est.pivot - start, u)), atol=1e-9)
 
 
 def test_a_lid_lifted_from_below_leads_by_lid_lift_lead_and_a_gripped_one_by_revolute_lead() -> None:
@@ -164,7 +208,7 @@ def test_a_lid_lifted_from_below_leads_by_lid_lift_lead_and_a_gripped_one_by_rev
     def goal(lift: bool, lift_lead: float) -> np.ndarray:
         """Where the opener sends the TCP (m, world) from ``now``, in one uncapped step."""
         cfg = _cfg(lid__lift__inward=0.0, lid__lift__lead=lift_lead, pull__revolute__lead=0.12,
-                                   move__max_step_m=1.0)
+                   lid__lift__press=0.0, move__max_step_m=1.0)
         opener = ScriptedOpener(cfg)
         opener.ctx.grasp.lid, opener.ctx.lift = True, lift
         opener.enter(start_pull(opener.ctx, start, np.eye(3), est, "closed"))

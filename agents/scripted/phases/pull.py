@@ -135,6 +135,8 @@ class Pull(OpenerPhase):
             return hold(GRIPPER_CLOSE), release.Release(why)
         away = grip.slip_offset(p - np.asarray(est.grasp_point, dtype=np.float64), u)
         far = float(np.linalg.norm(away)) > cfg.pull.slip_distance and not holding
+        if far and ctx.lift and grip.slip_behind(ctx.lift) > 0.0:
+            far = state - float(est.state) > grip.slip_behind(ctx.lift)
         track.slip_count = track.slip_count + 1 if far else 0
         slipped = track.slip_count >= cfg.pull.slip_steps
         if slipped and ctx.phase_log[-1].get("grip") == "held":
@@ -160,7 +162,7 @@ class Pull(OpenerPhase):
                 # along them, not the bar; grasp again turned, as after fingers closed on nothing
                 grasp.turn_fingers(ctx, arm_qpos)
             return hold(GRIPPER_OPEN), reach.pregrasp(ctx, "slip")
-        p_des, r_des = pull_pose(ctx, grip, est, u, pivot, state, revolute)
+        p_des, r_des = pull_pose(ctx, grip, est, u, pivot, state, revolute, p)
         action, _, _ = goto(ctx, p, r, p_des, r_des, GRIPPER_CLOSE)
         action[:6] *= step_share(ctx, arm_qpos)
         return action, self
@@ -192,12 +194,12 @@ def step_share(ctx: OpenerContext, arm_qpos: np.ndarray | None) -> float:
 
 
 def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u: np.ndarray,
-              pivot: np.ndarray, state: float, revolute: bool) -> tuple[np.ndarray, np.ndarray]:
+              pivot: np.ndarray, state: float, revolute: bool, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The TCP goal (position (3,), rotation (3, 3)) of a pull step: the grasp pose moved with the part
     to ``state + lead``, rotated about unit axis ``u`` through ``pivot`` (moved towards it by the
-    strategy ``grip``'s inward slide; the hand turned by its share and
-    then by the strategy's :meth:`~agents.scripted.part_strategies.PartStrategy.pull_rotation`) or
-    shifted along ``u``."""
+    strategy ``grip``'s inward slide and press from the hand's position ``p`` (3,); the hand turned by
+    its share and then by the strategy's
+    :meth:`~agents.scripted.part_strategies.PartStrategy.pull_rotation`) or shifted along ``u``."""
     cfg, track = ctx.cfg, ctx.pull
     assert track.grasp_p is not None and track.grasp_r is not None
     if not revolute:
@@ -213,9 +215,27 @@ def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u:
         radius = float(np.linalg.norm(radial))
         if radius > 1e-6:
             p_des = p_des - min(inward * max(delta, 0.0), 0.5 * radius) * radial / radius
+    press = grip.press(ctx.lift)
+    if press > 0.0:
+        # pushing from below, the fingertips stay pressed into the lid's front face from wherever
+        # they are: the estimated arc alone runs off the face as the lid turns
+        p_des = pressed(p_des, p, pivot, u, press)
     follow = grip.hand_turn(est, ctx.lift)
     turned = state - track.grasp_state
     return p_des, grip.pull_rotation(axis_angle_matrix(u, follow * delta) @ track.grasp_r, turned)
+
+
+def pressed(p_des: np.ndarray, p: np.ndarray, pivot: np.ndarray, u: np.ndarray, press: float) -> np.ndarray:
+    """``p_des`` (3,) moved along its radius about the axis (unit ``u``, through ``pivot``) so that it
+    lies at least ``press`` m nearer the axis than the hand ``p`` (3,) is now, and at most
+    ``2 * press`` nearer than ``p_des`` was (world frame, metres)."""
+    radial = off_axis(p_des - pivot, u)
+    rho_des = float(np.linalg.norm(radial))
+    if rho_des < 1e-6:
+        return p_des
+    rho_now = float(np.linalg.norm(off_axis(p - pivot, u)))
+    rho = max(min(rho_des, rho_now - press), rho_des - 2.0 * press)
+    return p_des + (rho - rho_des) * radial / rho_des
 
 
 def record_grip(ctx: OpenerContext, holding: bool, unknown: bool) -> None:
