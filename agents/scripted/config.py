@@ -437,7 +437,8 @@ class LidLiftConfig:
     def validate(self) -> None:
         _positive(self, "lead", where="lid.lift.")
         require(0.0 < self.pitch <= 1.5, f"lid.lift.pitch must be in (0, 1.5] rad, got {self.pitch}")
-        _non_negative(self, "below", "front", "under", "inward", "press", "slip_behind", where="lid.lift.", note=" m")
+        _non_negative(self, "below", "front", "under", "inward", "press", where="lid.lift.", note=" m")
+        _non_negative(self, "slip_behind", where="lid.lift.", note=" rad (0: off)")
         _share(self, "wrist_follow", where="lid.lift.")
 
 

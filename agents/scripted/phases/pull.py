@@ -194,7 +194,8 @@ def step_share(ctx: OpenerContext, arm_qpos: np.ndarray | None) -> float:
 
 
 def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u: np.ndarray,
-              pivot: np.ndarray, state: float, revolute: bool, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+              pivot: np.ndarray, state: float, revolute: bool,
+              p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The TCP goal (position (3,), rotation (3, 3)) of a pull step: the grasp pose moved with the part
     to ``state + lead``, rotated about unit axis ``u`` through ``pivot`` (moved towards it by the
     strategy ``grip``'s inward slide and press from the hand's position ``p`` (3,); the hand turned by
