@@ -222,10 +222,6 @@ class RevolutePullConfig:
     """The hand turns by this share of the part's angle about a hinge that is not vertical (a side door's
     hand turns fully): a grasped bar turns between the pads, and a hand turned fully with an oven door
     reaches the Panda's wrist limit."""
-    radial_give: float = 0.0
-    """While the fingers hold the part, the pull's goal keeps this share of the hand's own distance
-    from the hinge, the rest from the estimated arc (0: the arc alone): a hinge estimated a few cm
-    off makes the arc's radius fight the part's, and the handle pries the fingers open."""
     stop_above: float = 1.4
     """A hinged part (not a lid nor a door that falls open) whose pull stalls past this angle (rad), the
     fingers holding and no wrist joint at its limit, is at its end stop and is not grasped again (0:
@@ -233,7 +229,7 @@ class RevolutePullConfig:
 
     def validate(self) -> None:
         _positive(self, "lead", "target", "stall_progress", where="pull.revolute.")
-        _share(self, "wrist_follow", "radial_give", where="pull.revolute.")
+        _share(self, "wrist_follow", where="pull.revolute.")
         _non_negative(self, "stop_above", where="pull.revolute.", note=" rad (0: off)")
 
 

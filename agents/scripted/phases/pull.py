@@ -163,10 +163,6 @@ class Pull(OpenerPhase):
                 grasp.turn_fingers(ctx, arm_qpos)
             return hold(GRIPPER_OPEN), reach.pregrasp(ctx, "slip")
         p_des, r_des = pull_pose(ctx, grip, est, u, pivot, state, revolute, p)
-        give = cfg.pull.revolute.radial_give
-        if revolute and holding and not ctx.lift and give > 0.0:
-            # held, the part sets the hand's distance from its hinge: the goal gives way to it
-            p_des = given(p_des, p, pivot, u, give)
         action, _, _ = goto(ctx, p, r, p_des, r_des, GRIPPER_CLOSE)
         action[:6] *= step_share(ctx, arm_qpos)
         return action, self
@@ -241,17 +237,6 @@ def pressed(p_des: np.ndarray, p: np.ndarray, pivot: np.ndarray, u: np.ndarray, 
     rho_now = float(np.linalg.norm(off_axis(p - pivot, u)))
     rho = max(min(rho_des, rho_now - press), rho_des - 2.0 * press)
     return p_des + (rho - rho_des) * radial / rho_des
-
-
-def given(p_des: np.ndarray, p: np.ndarray, pivot: np.ndarray, u: np.ndarray, share: float) -> np.ndarray:
-    """``p_des`` (3,) moved along its radius about the axis (unit ``u``, through ``pivot``) by ``share``
-    of the way to the hand ``p``'s (3,) distance from the axis (world frame, metres)."""
-    radial = off_axis(p_des - pivot, u)
-    rho_des = float(np.linalg.norm(radial))
-    if rho_des < 1e-6:
-        return p_des
-    rho_now = float(np.linalg.norm(off_axis(p - pivot, u)))
-    return p_des + share * (rho_now - rho_des) * radial / rho_des
 
 
 def record_grip(ctx: OpenerContext, holding: bool, unknown: bool) -> None:
