@@ -204,17 +204,25 @@ def _read_assets(asset: etree._Element, model: _Model) -> None:
 
 
 def _angle_unit(model: _Model, requested: str) -> str:
+    """The unit of the model's hinge ranges and Euler angles: ``requested`` unless ``auto``, else the
+    compiler's. Without one, MuJoCo reads a full model in degrees; but a hinge whose range lies within
+    +-2 pi would then turn under 6.3 deg, which opens nothing: such files come from scenes that set
+    radians (Meta-World's fragments, robosuite's objects), so every hinge range within +-2 pi reads
+    as radians (a fragment with no ranges too), with a warning."""
     if requested in ("radian", "degree"):
         return requested
     if "angle" in model.compiler:
         return model.compiler["angle"]
-    if not model.is_fragment:
-        return "degree"  # MuJoCo's default for a full model
     ranges = [_floats(j.get("range"), "range") for r in model.roots for j in r.iter("joint")
               if j.get("range") and j.get("type", "hinge") == "hinge"]
-    unit = "radian" if all(np.all(np.abs(r) <= 2 * np.pi + 1e-6) for r in ranges) else "degree"
-    model.warnings.append(f"{model.path.name} sets no compiler angle; assumed {unit}s (an included fragment "
-                          "of a radian scene); set mjcf_angle to override")
+    small = all(np.all(np.abs(r) <= 2 * np.pi + 1e-6) for r in ranges)
+    if not model.is_fragment and (not ranges or not small):
+        return "degree"  # MuJoCo's default for a full model
+    unit = "radian" if small else "degree"
+    scene = "an included fragment of a radian scene" if model.is_fragment else (
+        "a full model whose hinge ranges, in degrees, would open nothing: written for a radian scene")
+    model.warnings.append(f"{model.path.name} sets no compiler angle; assumed {unit}s ({scene}); set "
+                          "mjcf_angle to override")
     return unit
 
 
