@@ -31,11 +31,20 @@ class PartPlane:
     outward: np.ndarray
 
 
-def part_plane(object_points: np.ndarray, part_points: np.ndarray) -> PartPlane | None:
+BODILESS_DEPTH = 0.03
+"""A part whose object's points centre within this (m) of its plane has no body behind it."""
+
+
+def part_plane(object_points: np.ndarray, part_points: np.ndarray,
+               viewpoint: np.ndarray | None = None) -> PartPlane | None:
     """The plane through most of ``part_points`` (M, 3) (seeded RANSAC, 1 cm band, refitted by PCA to
     those inliers: a segmentation's mislabelled body points would tilt a plain fit), its normal turned
-    away from the centroid of ``object_points`` (N, 3). None when no plane holds half of the part's
-    points (the part is not flat) or there are fewer than 10 of them."""
+    away from the centroid of ``object_points`` (N, 3): a part's outer face looks away from its body.
+    When that centroid lies within :data:`BODILESS_DEPTH` of the plane and ``viewpoint`` (3,) is
+    given, the normal is turned towards the viewpoint instead: a door in a bare frame has no body
+    behind it, its handle standing out in front pulls the centroid forwards, and the face the cameras
+    see is its outer one. None when no plane holds half of the part's points (the part is not flat)
+    or there are fewer than 10 of them. World frame, metres."""
     if len(part_points) < 10 or len(object_points) < 1:
         return None
     near, _ = ransac_plane(part_points, iterations=64, threshold=0.01, seed=0)
@@ -44,7 +53,10 @@ def part_plane(object_points: np.ndarray, part_points: np.ndarray) -> PartPlane 
     centre = part_points[near].mean(axis=0)
     vt = np.linalg.svd(part_points[near] - centre, full_matrices=False)[2]
     normal = vt[2]
-    if float((object_points.mean(axis=0) - centre) @ normal) > 0.0:
+    behind = float((object_points.mean(axis=0) - centre) @ normal)
+    if viewpoint is not None and abs(behind) < BODILESS_DEPTH:
+        behind = -float((np.asarray(viewpoint, dtype=np.float64) - centre) @ normal)
+    if behind > 0.0:
         normal = -normal
     return PartPlane(centre, vt[:2], normal)
 

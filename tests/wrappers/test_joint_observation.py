@@ -134,6 +134,25 @@ def test_bar_centre_of_a_bar_seen_from_above_is_the_middle_of_its_thickness() ->
     assert bar_centre(bar)[2] > 0.354  # the centroid sits on the seen top side
 
 
+def test_a_door_in_a_bare_frame_faces_the_cameras_not_away_from_its_handle() -> None:
+    # a door panel in the plane x = 0 between two frame posts, no body behind it, a lever standing
+    # 10 cm out towards the cameras (at x < 0): the handle pulls the object's centroid in front of the
+    # panel, which would turn the outward normal away from the cameras
+    rng = np.random.default_rng(5)
+    door = np.stack([np.zeros(600), rng.uniform(-0.2, 0.2, 600), rng.uniform(0.0, 0.6, 600)], axis=1)
+    posts = np.stack([np.zeros(100), np.repeat([-0.25, 0.25], 50), rng.uniform(0.0, 0.6, 100)], axis=1)
+    lever = np.stack([rng.uniform(-0.11, -0.09, 80), rng.uniform(0.05, 0.2, 80), np.full(80, 0.3)], axis=1)
+    cloud = np.concatenate([door, posts, lever])
+    cameras = np.array([-0.8, 0.0, 0.6])
+    seen = part_plane(cloud, door, viewpoint=cameras)
+    assert seen is not None and seen.outward[0] < -0.99
+    assert part_plane(cloud, door).outward[0] > 0.99  # the away-from-the-centroid rule alone
+    # with a body behind the door (a cabinet), the body decides even from behind
+    body = np.stack([rng.uniform(0.05, 0.4, 600), rng.uniform(-0.2, 0.2, 600), rng.uniform(0.0, 0.6, 600)], axis=1)
+    cabinet = np.concatenate([door, body, lever])
+    assert part_plane(cabinet, door, viewpoint=np.array([0.8, 0.0, 0.6])).outward[0] < -0.99
+
+
 def test_opening_direction_turns_the_axis_so_the_part_moves_away_from_its_body() -> None:
     rng = np.random.default_rng(3)
     cloud, door = _oven_like_scene(rng, with_handle=True)

@@ -78,7 +78,7 @@ class Draft:
         refiner chose (:meth:`use_plane`); None when the part is not flat."""
         if not self._plane_known:
             self.use_plane(moving_part_plane(self.points, self.moving, self.network.type,
-                                             unit(self.network.direction)))
+                                             unit(self.network.direction), self.viewpoint))
         return self._plane
 
     @property
@@ -143,11 +143,12 @@ class Refiner(Protocol):
 
 
 def moving_part_plane(points: np.ndarray, moving: np.ndarray, joint_type: str,
-                      direction: np.ndarray) -> PartPlane | None:
+                      direction: np.ndarray, viewpoint: np.ndarray | None = None) -> PartPlane | None:
     """The plane of the ``moving`` part's points (M, 3) (:func:`part_plane`, normal away from the
-    ``points`` (N, 3)); for a prismatic part only when it faces along the slide ``direction`` (3,):
-    an open drawer's largest plane is its bottom or a side, not its front. None otherwise."""
-    plane = part_plane(points, moving)
+    ``points`` (N, 3), or towards ``viewpoint`` (3,) for a part with no body behind it); for a
+    prismatic part only when it faces along the slide ``direction`` (3,): an open drawer's largest
+    plane is its bottom or a side, not its front. None otherwise."""
+    plane = part_plane(points, moving, viewpoint)
     if joint_type == "prismatic" and not faces_along(plane, direction):
         return None
     return plane
