@@ -106,7 +106,8 @@ def test_fragment_without_compiler_reads_radian_ranges_and_says_so(tmp_path: Pat
     assert float(limit.get("upper")) == pytest.approx(np.pi / 2)  # a full model's default is degrees
 
 
-def test_a_full_model_whose_hinge_would_turn_under_a_degree_reads_its_range_in_radians(tmp_path: Path) -> None:
+def test_a_full_model_whose_hinge_would_turn_under_a_degree_reads_its_range_in_radians(
+        tmp_path: Path) -> None:
     # robosuite's door: a full model with no compiler angle, merged into a radian scene by its
     # framework; in degrees its 0-0.4 range would turn the door 0.4 deg
     full = tmp_path / "door.xml"
@@ -117,7 +118,8 @@ def test_a_full_model_whose_hinge_would_turn_under_a_degree_reads_its_range_in_r
     assert _urdf(conv).find("joint[@type='revolute']/limit").get("upper") == "0.4"
     # the override still wins
     forced = convert_mjcf(full, tmp_path / "out2", angle="degree")
-    assert float(_urdf(forced).find("joint[@type='revolute']/limit").get("upper")) == pytest.approx(np.radians(0.4))
+    upper = float(_urdf(forced).find("joint[@type='revolute']/limit").get("upper"))
+    assert upper == pytest.approx(np.radians(0.4))
 
 
 def test_bad_include_malformed_file_and_missing_mesh_name_the_file_and_element(fragment: Path,

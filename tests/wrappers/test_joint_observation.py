@@ -148,7 +148,8 @@ def test_a_door_in_a_bare_frame_faces_the_cameras_not_away_from_its_handle() -> 
     assert seen is not None and seen.outward[0] < -0.99
     assert part_plane(cloud, door).outward[0] > 0.99  # the away-from-the-centroid rule alone
     # with a body behind the door (a cabinet), the body decides even from behind
-    body = np.stack([rng.uniform(0.05, 0.4, 600), rng.uniform(-0.2, 0.2, 600), rng.uniform(0.0, 0.6, 600)], axis=1)
+    body = np.stack([rng.uniform(0.05, 0.4, 600), rng.uniform(-0.2, 0.2, 600), rng.uniform(0.0, 0.6, 600)],
+                    axis=1)
     cabinet = np.concatenate([door, body, lever])
     assert part_plane(cabinet, door, viewpoint=np.array([0.8, 0.0, 0.6])).outward[0] < -0.99
 
