@@ -37,13 +37,14 @@ SHIPPED_OPENERS = {
                "fall_open_done": 1.3, "revolute_stop_above": 0.0, "rehearse_fingers": False,
                "rechoose_grasp_m": 0.0, "watch_falling": False, "prismatic_approach_pitch": 0.55,
                "prismatic_stop_above": 0.0, "rechoose_part_kind": False},
-    "drawer_cabinet": {"arc_fit": True, "regrasp_other_fingers": True, "quarter_turn": False,
+    # retrained in session 53 on that session's opener, which its run config records in full
+    "drawer_cabinet": {"arc_fit": True, "regrasp_other_fingers": True, "quarter_turn": True,
                        "approach_gap": 0.06,
-                       "wrist_limit_margin": 0.05, "lid_lift_lead": 0.12, "fall_open_done": 0.0,
-                       "revolute_stop_above": 0.0, "rehearse_fingers": False,
-                       "rechoose_grasp_m": 0.0, "watch_falling": False,
-                       "prismatic_approach_pitch": 0.55, "prismatic_stop_above": 0.0,
-                       "rechoose_part_kind": False},
+                       "wrist_limit_margin": 0.05, "lid_lift_lead": 0.2, "fall_open_done": 1.3,
+                       "revolute_stop_above": 1.4, "rehearse_fingers": True,
+                       "rechoose_grasp_m": 0.05, "watch_falling": True,
+                       "prismatic_approach_pitch": 0.3, "prismatic_stop_above": 0.15,
+                       "rechoose_part_kind": False, "lid.lift.press": 0.01, "lid.lift.slip_behind": 0.3},
 }
 
 
