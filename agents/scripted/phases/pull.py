@@ -135,8 +135,10 @@ class Pull(OpenerPhase):
             return hold(GRIPPER_CLOSE), release.Release(why)
         away = grip.slip_offset(p - np.asarray(est.grasp_point, dtype=np.float64), u)
         far = float(np.linalg.norm(away)) > cfg.pull.slip_distance and not holding
-        if far and ctx.lift and grip.slip_behind(ctx.lift) > 0.0:
-            far = state - float(est.state) > grip.slip_behind(ctx.lift)
+        behind = grip.slip_behind(ctx.lift)
+        if far and behind > 0.0:
+            # lifting, the closed fingers tell no gap: the perceived lid must also lag the hand
+            far = state - float(est.state) > behind
         track.slip_count = track.slip_count + 1 if far else 0
         slipped = track.slip_count >= cfg.pull.slip_steps
         if slipped and ctx.phase_log[-1].get("grip") == "held":
