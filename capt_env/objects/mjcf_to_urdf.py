@@ -5,9 +5,10 @@ Written by hand because ManiSkill's MJCF loader covers only part of MJCF's seman
 fragment meant for a radian scene omits it), and because no maintained MJCF-to-URDF converter is a
 dependency here. What is converted:
 
-- ``<include>`` (recursively, relative to the including file) and, for a Meta-World-style fragment
-  (no ``<mujoco>`` root or no ``<worldbody>``), its sibling ``X_dependencies.xml`` whose ``X`` is
-  the longest prefix of the fragment's stem (assets, materials, default classes, compiler);
+- ``<include>`` (recursively, relative to the including file) and, for a fragment (no ``<mujoco>``
+  root or no ``<worldbody>``), its sibling ``X_dependencies.xml`` (Meta-World) or ``X_asset.xml``
+  (Franka Kitchen) whose ``X`` is the longest prefix of the fragment's stem (assets, materials,
+  default classes, compiler; :func:`dependencies_file`);
 - ``<compiler angle meshdir eulerseq autolimits>``; ``<default>`` classes with nesting, ``class``
   and ``childclass`` inheritance;
 - body and geom frames (``pos``, ``quat``, ``euler``, ``axisangle``, ``xyaxes``, ``zaxis``, geom
@@ -112,12 +113,23 @@ def _tag_sources(elem: etree._Element, source: Path) -> None:
             node.set("_source", str(source))
 
 
+DEFINITION_SUFFIXES = ("dependencies", "asset", "assets", "deps", "defaults")
+"""Last name parts of a sibling file that holds a fragment's definitions: Meta-World's
+``drawer_dependencies.xml`` beside ``drawer.xml``, Franka Kitchen's (adept_models)
+``microwave_asset.xml`` beside ``microwave_chain.xml``."""
+
+
 def dependencies_file(fragment: Path) -> Path | None:
-    """The ``X_dependencies.xml`` next to a fragment whose ``X`` is the longest prefix of its stem."""
+    """The sibling that holds a fragment's assets and classes: ``X_<suffix>.xml`` (a suffix of
+    :data:`DEFINITION_SUFFIXES`) whose ``X`` is the longest prefix of the fragment's stem, or None.
+    A fragment's bodies name classes and meshes its project defines once per object in such a file
+    and includes both into one scene; the file is found by the object's name they share."""
     best, best_len = None, 0
-    for cand in fragment.parent.glob("*_dependencies.xml"):
-        prefix = cand.name[: -len("_dependencies.xml")]
-        if fragment.stem.startswith(prefix) and len(prefix) > best_len and cand != fragment:
+    for cand in fragment.parent.glob("*_*.xml"):
+        prefix, _, suffix = cand.stem.rpartition("_")
+        if suffix.lower() not in DEFINITION_SUFFIXES or cand == fragment:
+            continue
+        if prefix and fragment.stem.startswith(prefix) and len(prefix) > best_len:
             best, best_len = cand, len(prefix)
     return best
 

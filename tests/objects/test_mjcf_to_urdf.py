@@ -92,6 +92,26 @@ def test_fragment_with_include_default_class_and_mesh_converts(fragment: Path, t
     assert mass > 0.2  # the box's 0.2 kg plus the capsule at density 1000
 
 
+def test_a_chain_fragment_reads_the_classes_and_meshes_of_its_sibling_asset_file(tmp_path: Path) -> None:
+    # Franka Kitchen (adept_models): microwave_chain.xml holds the bodies, microwave_asset.xml
+    # the classes and meshes; a sibling of another object and a body file are not read
+    (tmp_path / "meshes").mkdir()
+    trimesh.creation.box(extents=[0.2, 0.1, 0.005]).export(tmp_path / "meshes" / "lid.stl")
+    (tmp_path / "box_asset.xml").write_text(DEPENDENCIES)
+    (tmp_path / "b_asset.xml").write_text("<mujocoinclude/>")  # a shorter prefix of the stem
+    (tmp_path / "boxes_chain2.xml").write_text("<mujocoinclude/>")
+    chain = tmp_path / "box_chain.xml"
+    chain.write_text('<mujocoinclude><body childclass="box_base"><geom type="box" size="0.1 0.1 0.1"/>'
+                     '<body name="lid" pos="0 0 0.1"><joint type="hinge" axis="1 0 0" range="0 1.5"/>'
+                     '<geom mesh="lid_mesh"/></body></body></mujocoinclude>')
+    assert dependencies_file(chain).name == "box_asset.xml"
+    conv = convert_mjcf(chain, tmp_path / "out")
+    joint = _urdf(conv).find("joint[@type='revolute']")
+    assert float(joint.find("dynamics").get("damping")) == 0.5  # the asset file's class
+    assert joint.find("limit").get("upper") == "1.5"  # its compiler's radians
+    assert dependencies_file(tmp_path / "other_chain.xml") is None
+
+
 def test_fragment_without_compiler_reads_radian_ranges_and_says_so(tmp_path: Path) -> None:
     path = tmp_path / "flap.xml"
     path.write_text('<mujocoinclude><body name="flap"><joint type="hinge" range="0 0.4"/>'
