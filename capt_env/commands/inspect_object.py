@@ -135,7 +135,10 @@ def run(args: argparse.Namespace) -> int:
             "path": str(path), "joints": joints, "links": _link_rows(env),
             "front_azimuth_rad": front_azimuth,
             "front_from": "option" if task.get("front_yaw") is not None else "guessed from the moving part",
-            "placement_xy_m": list(base.task_config.placement_xy()), "grasp_point_m": grasp_closed.tolist(),
+            "placement_xy_m": [round(float(v + d), 4) for v, d in zip(base.task_config.placement_xy(),
+                                                                      obj.placement_shift, strict=True)],
+            "placement_shift_m": [round(float(d), 4) for d in obj.placement_shift],
+            "grasp_point_m": grasp_closed.tolist(),
             "grasp_from": obj.grasp_source, "reach": reach, "warnings": list(obj.warnings),
         }
         png = Path(args.png or f"{path.stem}_inspect.png")
@@ -156,7 +159,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {row['link']:<24} {size} cm  {row['mass_kg']:.3f} kg")
     print(f"front: azimuth {math.degrees(front_azimuth):.0f} deg in the file's frame "
           f"({report['front_from']}), turned to face the robot")
-    print(f"placement: bounding-box centre at world xy {report['placement_xy_m']} m")
+    moved = (f" (moved {report['placement_shift_m']} m to bring the handle where the Panda reaches it)"
+             if any(report["placement_shift_m"]) else "")
+    print(f"placement: bounding-box centre at world xy {report['placement_xy_m']} m{moved}")
     print(f"grasp target ({obj.grasp_source}): {np.round(grasp_closed, 3).tolist()} m world")
     verdict = "in reach" if reach["ok"] else "OUT OF REACH: move it (object_xy) or scale it"
     print(f"reach from the Panda's shoulder: closed {reach['closed_m']:.2f} m, opened to "

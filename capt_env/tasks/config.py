@@ -21,6 +21,15 @@ DEFAULT_OBJECT_XY: tuple[float, float] = (0.3, 0.0)
 says otherwise."""
 CATEGORY_OBJECT_XY: dict[str, tuple[float, float]] = {"laptop": (-0.08, 0.0)}
 """Per-category placement (see :class:`TaskConfig`)."""
+USER_GRASP_X: tuple[float, float] = (0.02, 0.24)
+USER_GRASP_MAX_Y: float = 0.2
+"""World metres. A user file placed by default (no ``object_xy``) is moved, before the episode's
+noise, by the least distance that brings its closed grasp target into x in ``USER_GRASP_X`` and
+|y| <= ``USER_GRASP_MAX_Y``: the span of the procedural instances' grasp targets at their placements
+(x 0.02-0.24, |y| <= 0.2), where the opener was developed. A large file centred at 0.3 m can leave
+its handle under the resting hand (Franka Kitchen's hinged cabinet, 60 cm deep: x -0.08) or 30-40
+cm to the side (its microwave and sliding cabinet), where the Panda's wrist cannot turn with the
+part."""
 
 
 @dataclass(frozen=True)
@@ -76,7 +85,8 @@ class TaskConfig:
     (:data:`CATEGORY_OBJECT_XY`, else :data:`DEFAULT_OBJECT_XY`): 0.3 m keeps deep objects (ovens,
     cabinets) clear of the hand at reset; a laptop sits under the resting hand at -0.08 m, because
     its lid's lip, swung up to vertical 0.2-0.3 m behind where it started, is beyond the Panda's
-    reach from 0.3 m.
+    reach from 0.3 m. A user file placed by default is then moved so that its closed grasp target
+    lies where the procedural ones do (:data:`USER_GRASP_X`, :data:`USER_GRASP_MAX_Y`).
 
     Joint states at reset: the target joint starts at a fraction of its range uniform in
     ``target_init_fraction``; other joints uniform in ``other_init_fraction`` of their ranges.

@@ -120,6 +120,12 @@ class ObjectBatch:
         return np.array([[obj.aabb[0], obj.aabb[1]] for obj in self.objects], dtype=np.float64)
 
     @cached_property
+    def placement_shift(self) -> np.ndarray:
+        """(num_envs, 2) float64 world metres each object is moved from the task's placement (user
+        files placed by default: see :func:`capt_env.tasks.object_loading.grasp_reach_shift`)."""
+        return np.array([obj.placement_shift for obj in self.objects], dtype=np.float64)
+
+    @cached_property
     def front_yaw(self) -> np.ndarray:
         """(num_envs,) float64 yaw (rad) that turns each object's front towards the robot (-x)."""
         return np.array([obj.front_yaw for obj in self.objects], dtype=np.float64)

@@ -26,7 +26,7 @@ from capt_env.objects.registry import make_object
 from capt_env.objects.spec import ObjectSpec
 from capt_env.objects.splits import instance_ids as split_instance_ids
 from capt_env.objects.user_files import load_user_object
-from capt_env.tasks.config import TaskConfig
+from capt_env.tasks.config import USER_GRASP_MAX_Y, USER_GRASP_X, TaskConfig
 from capt_env.tasks.grasp_target import GraspTarget, find_grasp_target
 
 # Revolute joints without finite limits (URDF "continuous") are treated as [-pi, pi].
@@ -58,6 +58,7 @@ class LoadedObject:
 
     warnings: tuple[str, ...] = ()  # what loading a user file ignored or approximated
     grasp_source: str = "spec"  # how the grasp target was found (see grasp_target.py)
+    placement_shift: tuple[float, float] = (0.0, 0.0)  # world metres added to the placement (user files)
 
     @property
     def dof(self) -> int:
@@ -179,14 +180,33 @@ def _load_user_file(scene: Any, cfg: TaskConfig) -> LoadedObject:
     front = cfg.front_yaw_radians()
     if front is None:
         front = _guess_front_azimuth(art, grasp_link, grasp, aabb)
+    grasp_closed = _pose_matrix(grasp_link.pose)[:3, :3] @ grasp.point + _pose_matrix(grasp_link.pose)[:3, 3]
+    shift = ((0.0, 0.0) if cfg.object_xy is not None
+             else grasp_reach_shift(grasp_closed, aabb, float(math.pi - front), cfg.placement_xy()))
     return LoadedObject(
         articulation=art, name="object", category="user", instance_id=-1, spec=None,
         joints=joints, joint_names=names, joint_type_ids=type_ids, limits=_task_limits(sim_limits),
         closed_qpos=closed_qpos, open_sign=open_sign, child_parts=child_parts, target_joint=target,
         grasp_link=grasp_link, grasp_local=grasp.point, aabb=aabb, front_yaw=float(math.pi - front),
         segmentation_lut=_segmentation_lut(art, joints), warnings=tuple(warnings),
-        grasp_source=grasp.source,
+        grasp_source=grasp.source, placement_shift=shift,
     )
+
+
+def grasp_reach_shift(grasp: np.ndarray, aabb: tuple[np.ndarray, np.ndarray], yaw: float,
+                      placement_xy: tuple[float, float]) -> tuple[float, float]:
+    """The world (dx, dy) metres that moves an object, its bounding-box centre placed at
+    ``placement_xy`` and turned by ``yaw`` rad, the least distance that brings its closed grasp
+    target ``grasp`` (3,) (object frame, like ``aabb``) into :data:`USER_GRASP_X` x
+    [-:data:`USER_GRASP_MAX_Y`, :data:`USER_GRASP_MAX_Y`]; (0, 0) when it lies there already."""
+    centre = (np.asarray(aabb[0], dtype=np.float64) + np.asarray(aabb[1], dtype=np.float64)) / 2
+    c, s = math.cos(yaw), math.sin(yaw)
+    off = np.asarray(grasp, dtype=np.float64)[:2] - centre[:2]
+    x = placement_xy[0] + c * off[0] - s * off[1]
+    y = placement_xy[1] + s * off[0] + c * off[1]
+    dx = float(np.clip(x, *USER_GRASP_X) - x)
+    dy = float(np.clip(y, -USER_GRASP_MAX_Y, USER_GRASP_MAX_Y) - y)
+    return (dx, dy)
 
 
 MIN_PART_MASS = 0.05

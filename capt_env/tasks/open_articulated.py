@@ -237,10 +237,12 @@ class OpenArticulatedEnv(BaseEnv):
 
     def _placement(self, rows: np.ndarray, noise_xy: torch.Tensor, yaw: torch.Tensor) -> _Placement:
         """Root poses putting the bounding-box centre of the objects of sub-scenes ``rows`` (b,) at
-        ``placement_xy() + noise_xy`` (b, 2) on the table, turned by ``yaw`` (b,) radians."""
+        ``placement_xy()`` + the object's ``placement_shift`` + ``noise_xy`` (b, 2) on the table,
+        turned by ``yaw`` (b,) radians."""
         lo, hi = self.object_batch.aabb[rows, 0], self.object_batch.aabb[rows, 1]  # (b, 3) object frame
         centre_local = torch.as_tensor((lo + hi) / 2, dtype=torch.float32)
-        target_xy = torch.as_tensor(self.task_config.placement_xy(), dtype=torch.float32) + noise_xy
+        shift = torch.as_tensor(self.object_batch.placement_shift[rows], dtype=torch.float32)
+        target_xy = torch.as_tensor(self.task_config.placement_xy(), dtype=torch.float32) + shift + noise_xy
         c, s = torch.cos(yaw), torch.sin(yaw)
         rot_cx = c * centre_local[:, 0] - s * centre_local[:, 1]
         rot_cy = s * centre_local[:, 0] + c * centre_local[:, 1]

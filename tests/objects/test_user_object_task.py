@@ -238,3 +238,35 @@ def test_a_continuous_joint_loads_with_a_full_turn_of_range(tmp_path: Path) -> N
         env.reset(seed=1)
     finally:
         env.close()
+
+
+def test_a_large_file_placed_by_default_is_moved_until_its_handle_lies_where_the_panda_reaches(
+        tmp_path: Path) -> None:
+    # twice the size: 60 cm deep, centred at 0.3 m its handle stands under the resting hand and 70
+    # cm to the side; placed by default it is moved just far enough, placed by hand it is left be
+    from capt_env.tasks.config import USER_GRASP_MAX_Y, USER_GRASP_X
+    closed = {"scale": 2.0, "target_init_fraction": [0.0, 0.0]}
+    env = make(tmp_path, cabinet_urdf(), **closed)
+    told = make(tmp_path, cabinet_urdf(), name="told.urdf", object_xy=[0.3, 0.0], **closed)
+    try:
+        env.reset(seed=0)
+        told.reset(seed=0)
+        x, y = env.object_batch.grasp_point()[0, :2].tolist()
+        x0, y0 = told.object_batch.grasp_point()[0, :2].tolist()
+        assert x0 < USER_GRASP_X[0] and abs(y0) > USER_GRASP_MAX_Y
+        assert x == pytest.approx(USER_GRASP_X[0], abs=1e-3)
+        assert abs(y) == pytest.approx(USER_GRASP_MAX_Y, abs=1e-3)
+        assert told.object.placement_shift == (0.0, 0.0)
+    finally:
+        env.close()
+        told.close()
+
+
+def test_a_handle_already_within_reach_leaves_the_placement_as_it_is() -> None:
+    from capt_env.tasks.object_loading import grasp_reach_shift
+    aabb = (np.array([-0.1, -0.1, 0.0]), np.array([0.1, 0.1, 0.2]))
+    # front turned to -x (yaw 0): a handle 12 cm before the centre at x 0.3 lies at 0.18
+    assert grasp_reach_shift(np.array([-0.12, 0.05, 0.1]), aabb, 0.0, (0.3, 0.0)) == (0.0, 0.0)
+    dx, dy = grasp_reach_shift(np.array([-0.12, 0.05, 0.1]), aabb, np.pi / 2, (0.3, 0.3))
+    # turned a quarter: the handle lies at (0.25, 0.18): 1 cm too far
+    assert dx == pytest.approx(-0.01) and dy == 0.0
