@@ -6,7 +6,8 @@ surface by area. Order of preference:
 1. A ``handle`` the user names (a link or geom name on the moving part).
 2. Geometry named like a handle (``handle``, ``knob``, ``pull``, ``grip``, ``lever``).
 3. Geometry standing off the part's outer face by more than ``STANDOFF`` (bar handles of any
-   orientation, knobs, levers however far they stand off): its largest connected piece.
+   orientation, knobs, levers however far they stand off): of its connected pieces, the one that
+   stands farthest off (:func:`_proudest_piece`).
 4. No handle: the middle of the free edge of the outer face (a hinged part), or the middle of the
    outer face (a sliding part), where a hand can hook or pinch.
 
@@ -33,6 +34,8 @@ GRIP_DEPTH = 0.015
 """m: depth of a handle's outermost layer, about a Panda fingertip's width."""
 CLUSTER_RADIUS = 0.02
 """m: surface points closer than this belong to the same piece of a handle."""
+MIN_PIECE_SHARE = 0.05
+"""A piece standing off the face with fewer than this share of the standing points is a speck."""
 FACE_BIN = 0.002
 """m: histogram bin for finding the outer face's level."""
 SAMPLES = 20000
@@ -119,7 +122,13 @@ def _grip_centre(points: np.ndarray, outward: np.ndarray) -> np.ndarray:
     return points[h >= h.max() - GRIP_DEPTH].mean(axis=0)
 
 
-def _largest_piece(points: np.ndarray) -> np.ndarray:
+def _proudest_piece(points: np.ndarray, outward: np.ndarray) -> np.ndarray:
+    """Of the connected pieces (``CLUSTER_RADIUS``) of the points (N, 3) standing off a part's face,
+    the one that stands farthest along ``outward``, among pieces of at least ``MIN_PIECE_SHARE`` of
+    the points. A handle stands proud of everything else on a face; a panel whose face normal leans
+    a few degrees towards a handle at one end (the least spread of a door with a thick bar at its
+    free edge: Franka Kitchen's microwave, 3 deg) rises off that normal's face level at its far end
+    too, in a larger piece that stands off only a couple of centimetres."""
     if len(points) < 2:
         return points
     pairs = cKDTree(points).query_pairs(CLUSTER_RADIUS, output_type="ndarray")
@@ -128,7 +137,11 @@ def _largest_piece(points: np.ndarray) -> np.ndarray:
     n = len(points)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
     _, labels = connected_components(graph, directed=False)
-    return points[labels == np.bincount(labels).argmax()]
+    sizes = np.bincount(labels)
+    heights = points @ outward
+    big = [k for k in range(len(sizes)) if sizes[k] >= max(5, MIN_PIECE_SHARE * n)]
+    best = max(big, key=lambda k: float(heights[labels == k].max())) if big else int(sizes.argmax())
+    return points[labels == best]
 
 
 def find_grasp_target(meshes: list[ShapeMesh], mesh_links: list[str], axis: np.ndarray, pivot: np.ndarray,
@@ -163,7 +176,7 @@ def find_grasp_target(meshes: list[ShapeMesh], mesh_links: list[str], axis: np.n
     face = face_level(heights)
     standing = points[heights > face + STANDOFF]
     if len(standing) >= 5:
-        return GraspTarget(_grip_centre(_largest_piece(standing), outward), outward, "geometry")
+        return GraspTarget(_grip_centre(_proudest_piece(standing, outward), outward), outward, "geometry")
     on_face = points[np.abs(heights - face) <= 0.005]
     if len(on_face) == 0:
         on_face = points
