@@ -6,6 +6,7 @@ the sign of a joint axis that opens the part (moves it away from its body).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -204,6 +205,28 @@ def opening_direction(joint_type: str, direction: np.ndarray, pivot: np.ndarray,
     return -u if float(motion @ outward) < 0.0 else u
 
 
+def double_door_seam(grasp: np.ndarray, other_handles: Sequence[np.ndarray], centre: np.ndarray,
+                     across: np.ndarray, along: np.ndarray, min_apart: float = 0.06,
+                     max_height: float = 0.1) -> float | None:
+    """Where (m across, unit ``across`` (3,) from ``centre`` (3,)) two doors meet, when one of
+    ``other_handles`` (each (3,)) stands beside the ``grasp`` (3,) handle: at least ``min_apart`` m
+    from it across and within ``max_height`` m of its height along ``along`` (3,) (the two doors of
+    a double door carry their handles side by side near where they meet): half-way between them;
+    None when none does. World frame, metres."""
+    s_grasp = float((grasp - centre) @ across)
+    h_grasp = float((grasp - centre) @ along)
+    beside = []
+    for other in other_handles:
+        d = np.asarray(other, dtype=np.float64) - centre
+        s_other, h_other = float(d @ across), float(d @ along)
+        if abs(s_other - s_grasp) >= min_apart and abs(h_other - h_grasp) <= max_height:
+            beside.append(s_other)
+    if not beside:
+        return None
+    nearest = min(beside, key=lambda s_other: abs(s_other - s_grasp))
+    return (s_grasp + nearest) / 2.0
+
+
 def edge_aligned_direction(direction: np.ndarray, plane: PartPlane, part_points: np.ndarray,
                            max_turn: float = 0.6, min_fill: float = 0.85,
                            band: float = 0.01, min_aspect: float = 0.25) -> np.ndarray:
@@ -262,7 +285,9 @@ def edge_aligned_direction(direction: np.ndarray, plane: PartPlane, part_points:
 def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, part_points: np.ndarray,
                   pivot: np.ndarray | None = None, tolerance: float = 0.06,
                   edge_quantile: float = 0.02, min_aspect: float = 0.25,
-                  panel_points: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                  panel_points: np.ndarray | None = None,
+                  other_handles: Sequence[np.ndarray] = (),
+                  pair_doors: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """A flat part's hinge line checked against its points: (unit direction (3,), pivot (3,)), world
     frame, metres.
 
@@ -278,7 +303,12 @@ def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, pa
     direction as along it is a bar (an eyeglasses temple), not a flat panel: then the direction is returned
     unchanged, with ``pivot`` (or the plane's centre) moved along it. ``panel_points`` (K, 3), when
     given, replace ``part_points`` for finding the edges (the whole panel the part lies on:
-    :func:`coplanar_panel`); the bar test stays on ``part_points``.
+    :func:`coplanar_panel`); the bar test stays on ``part_points``. A handle across the axis within
+    ``other_handles`` (each (3,)) holds the panel's other handles: one beside the grasp's, at its
+    height (:func:`double_door_seam`), makes the panel two doors meeting between their handles (a
+    double door, flush and coplanar, segmented as one part), and the grasp's door is hinged on the
+    panel's edge on its side of that seam, not on the far edge, the other door's hinge
+    (``pair_doors``; off: the far edge always).
     """
     g = np.asarray(grasp, dtype=np.float64)
     u = unit(direction)
@@ -294,7 +324,11 @@ def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, pa
     s = (edges_of - plane.centre) @ across
     s_grasp = float((g - plane.centre) @ across)
     lo, hi = np.quantile(s, [edge_quantile, 1.0 - edge_quantile])
-    edge = float(lo if abs(s_grasp - lo) > abs(s_grasp - hi) else hi)
+    far_lo = abs(s_grasp - lo) > abs(s_grasp - hi)
+    seam = double_door_seam(g, other_handles, plane.centre, across, along) if pair_doors else None
+    if seam is not None:
+        far_lo = s_grasp < seam  # two doors meet between the handles: the edge on the grasp's side
+    edge = float(lo if far_lo else hi)
     line_point = plane.centre + across * edge
     if pivot is not None:
         p = np.asarray(pivot, dtype=np.float64)

@@ -246,6 +246,31 @@ def test_hinge_on_edge_moves_a_far_off_line_onto_the_door_edge_away_from_the_han
     np.testing.assert_allclose(pivot, [0.05, -0.1, 0.35], atol=1e-9)
 
 
+def test_a_double_door_read_as_one_part_is_hinged_on_the_edge_on_its_handles_side() -> None:
+    # Franka Kitchen's hinged cabinet: two 39 cm doors flush in the plane x = 0, meeting at y = 0,
+    # their handles 8 cm either side of the seam. The network segments both as one 78 cm part;
+    # the edge farthest from the right door's handle is the left door's hinge.
+    rng = np.random.default_rng(6)
+    doors = np.stack([np.zeros(1600), rng.uniform(-0.39, 0.39, 1600), rng.uniform(0.0, 0.4, 1600)], axis=1)
+    body = np.stack([rng.uniform(0.02, 0.6, 800), rng.uniform(-0.39, 0.39, 800), np.full(800, 0.42)], axis=1)
+    plane = part_plane(np.concatenate([doors, body]), doors)
+    assert plane is not None
+    right_handle, left_handle = np.array([-0.1, -0.08, 0.2]), np.array([-0.1, 0.08, 0.2])
+    up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
+    _, pivot = hinge_on_edge(up, right_handle, plane, doors, other_handles=[left_handle])
+    np.testing.assert_allclose(pivot[:2], [0.0, -0.39], atol=0.02)
+    _, pivot = hinge_on_edge(down, left_handle, plane, doors, other_handles=[right_handle])
+    np.testing.assert_allclose(pivot[:2], [0.0, 0.39], atol=0.02)
+    # one handle, or the other one far above it (a knob on an oven's control strip): a single door,
+    # hinged on the edge away from its handle
+    for others in ([], [np.array([-0.05, 0.1, 0.38])]):
+        _, pivot = hinge_on_edge(up, right_handle, plane, doors, other_handles=others)
+        np.testing.assert_allclose(pivot[:2], [0.0, 0.39], atol=0.02)
+    # off: the far edge, the other door's hinge
+    _, pivot = hinge_on_edge(up, right_handle, plane, doors, other_handles=[left_handle], pair_doors=False)
+    np.testing.assert_allclose(pivot[:2], [0.0, 0.39], atol=0.02)
+
+
 def test_the_panel_of_a_half_segmented_door_gives_the_hinge_on_its_far_edge() -> None:
     rng = np.random.default_rng(5)
     cloud, door = _oven_like_scene(rng, with_handle=True)

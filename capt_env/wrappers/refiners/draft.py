@@ -43,8 +43,9 @@ class Draft:
 
     The estimate: ``joint_type``, ``direction`` (3,) unit, ``pivot`` (3,) a point on the line,
     ``state`` (rad or m), ``confidence``, ``grasp`` (3,) or None until a handle is found or the
-    grasp is settled (:meth:`settle_grasp`), ``from_handle`` (the grasp point is on a handle).
-    ``fired`` lists the refiners that changed the draft, in order.
+    grasp is settled (:meth:`settle_grasp`), ``from_handle`` (the grasp point is on a handle),
+    ``other_handles`` the other handles found on the panel (each (3,)). ``fired`` lists the refiners
+    that changed the draft, in order.
     """
 
     points: np.ndarray
@@ -65,6 +66,7 @@ class Draft:
     grasp: np.ndarray | None = None
     from_handle: bool = False
     viewpoint: np.ndarray | None = None
+    other_handles: list[np.ndarray] = field(default_factory=list)
     fired: list[str] = field(default_factory=list)
     _plane: PartPlane | None = field(default=None, repr=False)
     _plane_known: bool = field(default=False, repr=False)

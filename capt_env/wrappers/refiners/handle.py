@@ -82,6 +82,7 @@ class Handle:
         if not handles:
             return False
         draft.grasp, draft.from_handle = handles[0].point, True
+        draft.other_handles = [g.point for g in handles[1:]]
         return True
 
 

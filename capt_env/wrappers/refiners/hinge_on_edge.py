@@ -1,7 +1,10 @@
 """Refiner ``hinge_on_edge``: a flat part's hinge line lies on its edge away from the handle.
 
 Geometric reason: a closed door, lid or oven door turns about a line in (or just behind) its own
-plane along its edge farthest from the handle. The direction is projected into the part's plane
+plane along its edge farthest from the handle. A panel with a second handle beside the grasp's, at
+its height, is two coplanar doors meeting between their handles (a double door the network reads as
+one part; Franka Kitchen's hinged cabinet): the grasp's door is hinged on the panel's edge on its
+side of that seam (``pair_doors``). The direction is projected into the part's plane
 (its in-plane component kept, so the network still decides which edge), and the network's line is
 kept when it lies within ``tolerance`` of that edge and of the plane, else it is put on the edge
 (the ``edge_quantile`` of the ``panel``'s points across the axis). On a real microwave the
@@ -33,6 +36,9 @@ class HingeOnEdgeConfig:
     tolerance: float = 0.06
     edge_quantile: float = 0.02
     min_aspect: float = 0.25
+    pair_doors: bool = True
+    """A second handle beside the grasp's, at its height, makes the panel a double door: the grasp's
+    door is hinged on the panel's edge on its side of the seam between them."""
 
     def validate(self) -> None:
         require(self.tolerance >= 0, "hinge_on_edge.tolerance must be >= 0 (metres)")
@@ -58,7 +64,9 @@ class HingeOnEdge:
         draft.direction, draft.pivot = hinge_on_edge(draft.direction, grasp, plane, draft.moving,
                                                      pivot=draft.pivot, tolerance=c.tolerance,
                                                      edge_quantile=c.edge_quantile,
-                                                     min_aspect=c.min_aspect, panel_points=draft.panel)
+                                                     min_aspect=c.min_aspect, panel_points=draft.panel,
+                                                     other_handles=draft.other_handles,
+                                                     pair_doors=c.pair_doors)
         # fired: the line moved (the old pivot over 1 mm off the new line) or turned over 1 mrad; a
         # kept line still gets the projection into the plane, a rounding-sized turn
         off_line = np.cross(before[1] - draft.pivot, draft.direction)
