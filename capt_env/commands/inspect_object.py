@@ -1,8 +1,9 @@
 """``capt inspect-object PATH``: check a user's URDF/MJCF file in the task before running anything.
 
 Prints the movable joints (type, limits, which limit is closed), each link's size and mass, the
-front the task turns to the robot, the placement, the grasp target and whether the Panda can reach
-it closed and opened to the success fraction; writes a PNG of the object seen from the task's first
+front the task turns to the robot, the placement, the grasp target (and how far a handle stands off
+the part's face, against the band CAPT's handle search looks in) and whether the Panda can reach it
+closed and opened to the success fraction; writes a PNG of the object seen from the task's first
 camera with the target joint's axis drawn (red, arrow at the end that opens).
 """
 
@@ -139,7 +140,8 @@ def run(args: argparse.Namespace) -> int:
                                                                       obj.placement_shift, strict=True)],
             "placement_shift_m": [round(float(d), 4) for d in obj.placement_shift],
             "grasp_point_m": grasp_closed.tolist(),
-            "grasp_from": obj.grasp_source, "reach": reach, "warnings": list(obj.warnings),
+            "grasp_from": obj.grasp_source, "grasp_standoff_m": obj.grasp_standoff,
+            "reach": reach, "warnings": list(obj.warnings),
         }
         png = Path(args.png or f"{path.stem}_inspect.png")
         report["png"] = str(_picture(png, env, axis, pivot, grasp_closed,
@@ -163,6 +165,17 @@ def run(args: argparse.Namespace) -> int:
              if any(report["placement_shift_m"]) else "")
     print(f"placement: bounding-box centre at world xy {report['placement_xy_m']} m{moved}")
     print(f"grasp target ({obj.grasp_source}): {np.round(grasp_closed, 3).tolist()} m world")
+    standoff = report["grasp_standoff_m"]
+    if standoff is not None and obj.grasp_source != "edge":
+        from capt_env.wrappers.refiners.handle import HandleConfig
+
+        band = HandleConfig()
+        note = ""
+        if standoff > band.max_standoff:
+            note = (f": beyond the band CAPT's handle search looks in ({100 * band.min_standoff:.1f}-"
+                    f"{100 * band.max_standoff:.0f} cm off the face): with CAPT the grasp may fall back "
+                    "to another piece or the part's edge")
+        print(f"handle: its grip stands {100 * standoff:.1f} cm off the part's face{note}")
     verdict = "in reach" if reach["ok"] else "OUT OF REACH: move it (object_xy) or scale it"
     print(f"reach from the Panda's shoulder: closed {reach['closed_m']:.2f} m, opened to "
           f"{base.task_config.success_fraction:.0%} {reach['opened_m']:.2f} m "

@@ -51,6 +51,7 @@ class GraspTarget:
     point: np.ndarray  # (3,) metres
     outward: np.ndarray  # (3,) unit
     source: str  # "option", "name", "geometry" or "edge"
+    standoff: float | None = None  # metres the point stands off the outer face along ``outward``
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -158,6 +159,12 @@ def find_grasp_target(meshes: list[ShapeMesh], mesh_links: list[str], axis: np.n
     if len(points) == 0:
         raise ObjectFileError("the moving part has no visual geometry to grasp")
     outward = outward_normal(points, axis, pivot, revolute, object_centre)
+    heights = points @ outward
+    face = face_level(heights)
+
+    def target(point: np.ndarray, source: str) -> GraspTarget:
+        return GraspTarget(point, outward, source, float(point @ outward - face))
+
     names = [(m.name, link) for m, link in zip(meshes, mesh_links, strict=True)]
     if handle is not None:
         picked = [k for k, (geom, link) in enumerate(names) if handle in (geom, link)]
@@ -165,18 +172,16 @@ def find_grasp_target(meshes: list[ShapeMesh], mesh_links: list[str], axis: np.n
             known = sorted({n for pair in names for n in pair if n})
             raise ObjectFileError(
                 f"handle {handle!r} is not a link or geom of the moving part; it has {known}")
-        return GraspTarget(_grip_centre(points[np.isin(owner, picked)], outward), outward, "option")
+        return target(_grip_centre(points[np.isin(owner, picked)], outward), "option")
     # A handle is a geom named like one, or a link named like one fixed to the part (not the part
     # itself: a "pull-out tray" link is the whole part).
     named = [k for k, (geom, link) in enumerate(names)
              if HANDLE_NAME.search(geom) or (link != part_name and HANDLE_NAME.search(link))]
     if named and np.isin(owner, named).any():
-        return GraspTarget(_grip_centre(points[np.isin(owner, named)], outward), outward, "name")
-    heights = points @ outward
-    face = face_level(heights)
+        return target(_grip_centre(points[np.isin(owner, named)], outward), "name")
     standing = points[heights > face + STANDOFF]
     if len(standing) >= 5:
-        return GraspTarget(_grip_centre(_proudest_piece(standing, outward), outward), outward, "geometry")
+        return target(_grip_centre(_proudest_piece(standing, outward), outward), "geometry")
     on_face = points[np.abs(heights - face) <= 0.005]
     if len(on_face) == 0:
         on_face = points
@@ -185,5 +190,5 @@ def find_grasp_target(meshes: list[ShapeMesh], mesh_links: list[str], axis: np.n
         rel = on_face - pivot
         dist = np.linalg.norm(rel - np.outer(rel @ a, a), axis=1)
         edge = on_face[dist >= dist.max() - 0.02]
-        return GraspTarget(edge.mean(axis=0), outward, "edge")
-    return GraspTarget(on_face.mean(axis=0), outward, "edge")
+        return target(edge.mean(axis=0), "edge")
+    return target(on_face.mean(axis=0), "edge")

@@ -59,6 +59,7 @@ class LoadedObject:
     warnings: tuple[str, ...] = ()  # what loading a user file ignored or approximated
     grasp_source: str = "spec"  # how the grasp target was found (see grasp_target.py)
     placement_shift: tuple[float, float] = (0.0, 0.0)  # world metres added to the placement (user files)
+    grasp_standoff: float | None = None  # m the grasp target stands off the part's face (user files)
 
     @property
     def dof(self) -> int:
@@ -189,7 +190,7 @@ def _load_user_file(scene: Any, cfg: TaskConfig) -> LoadedObject:
         closed_qpos=closed_qpos, open_sign=open_sign, child_parts=child_parts, target_joint=target,
         grasp_link=grasp_link, grasp_local=grasp.point, aabb=aabb, front_yaw=float(math.pi - front),
         segmentation_lut=_segmentation_lut(art, joints), warnings=tuple(warnings),
-        grasp_source=grasp.source, placement_shift=shift,
+        grasp_source=grasp.source, placement_shift=shift, grasp_standoff=grasp.standoff,
     )
 
 

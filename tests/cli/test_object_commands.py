@@ -71,6 +71,9 @@ def test_inspect_object_reports_joints_reach_and_writes_a_picture(drawer_urdf: P
     report = json.loads(out.read_text())
     assert png.is_file() and png.stat().st_size > 5000
     assert report["grasp_from"] == "geometry" and report["reach"]["ok"]
+    # the procedural drawer's bar stands a few cm off its front, within CAPT's handle search
+    assert 0.01 < report["grasp_standoff_m"] < 0.08 and "handle: its grip stands" in text
+    assert "beyond the band" not in text
     assert [j["closed_at"] for j in report["joints"]] == ["lower", "lower"]
     assert abs(report["front_azimuth_rad"]) == pytest.approx(np.pi)  # procedural fronts face -x
 

@@ -68,6 +68,7 @@ def test_lever_standing_12cm_off_the_panel_is_found() -> None:
     assert target.source == "geometry"
     assert target.point[0] < -0.11
     assert abs(target.point[2] - 0.25) < 0.01
+    assert 0.11 < target.standoff < 0.14  # how far the grip stands off the face, for inspect-object
 
 
 def test_a_named_handle_wins_over_geometry() -> None:
