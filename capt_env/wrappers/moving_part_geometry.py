@@ -303,8 +303,8 @@ def hinge_on_edge(direction: np.ndarray, grasp: np.ndarray, plane: PartPlane, pa
     direction as along it is a bar (an eyeglasses temple), not a flat panel: then the direction is returned
     unchanged, with ``pivot`` (or the plane's centre) moved along it. ``panel_points`` (K, 3), when
     given, replace ``part_points`` for finding the edges (the whole panel the part lies on:
-    :func:`coplanar_panel`); the bar test stays on ``part_points``. A handle across the axis within
-    ``other_handles`` (each (3,)) holds the panel's other handles: one beside the grasp's, at its
+    :func:`coplanar_panel`); the bar test stays on ``part_points``. ``other_handles`` (each (3,))
+    holds the panel's other handles: one beside the grasp's, at its
     height (:func:`double_door_seam`), makes the panel two doors meeting between their handles (a
     double door, flush and coplanar, segmented as one part), and the grasp's door is hinged on the
     panel's edge on its side of that seam, not on the far edge, the other door's hinge
