@@ -185,6 +185,23 @@ def test_handle_grasps_the_bar_standing_off_the_door() -> None:
     np.testing.assert_allclose(draft.grasp, HANDLE, atol=0.01)
 
 
+def test_only_a_matching_handle_counts_as_the_other_leaf_of_a_double_door() -> None:
+    # a double door carries the same handle on both leaves, mirrored; a lock knob beside a lever, or
+    # a lever seen beside another piece of an open door, is no twin (the Meta-World lock door)
+    from capt_env.wrappers.grasp_candidates import GraspCandidate
+    from capt_env.wrappers.refiners.handle import twin
+
+    def cand(kind: str, axis: tuple[float, float, float]) -> GraspCandidate:
+        return GraspCandidate(kind, np.zeros(3), np.array([-1.0, 0.0, 0.0]), np.asarray(axis, float),
+                              0.02, 0.1, 1.0)
+
+    bar = cand("bar", (0.0, 0.0, 1.0))
+    assert twin(cand("bar", (0.0, 0.1, 0.995)), bar)  # a second upright bar: the other leaf
+    assert not twin(cand("bar", (0.0, 1.0, 0.0)), bar)  # a level bar beside an upright one
+    assert not twin(cand("knob", (0.0, 0.0, 1.0)), bar)
+    assert twin(cand("knob", (0.0, 1.0, 0.0)), cand("knob", (0.0, 0.0, 1.0)))  # knobs: no axis to match
+
+
 def test_handle_does_not_fire_on_a_door_without_one() -> None:
     points, labels = _door(np.random.default_rng(0), handle=False)
     draft = _draft(points, labels, _hinge())

@@ -29,7 +29,7 @@ from typing import ClassVar
 import numpy as np
 
 from capt_common.typed_yaml import require
-from capt_env.wrappers.grasp_candidates import GraspCandidateConfig, find_grasp_candidates
+from capt_env.wrappers.grasp_candidates import GraspCandidate, GraspCandidateConfig, find_grasp_candidates
 from capt_env.wrappers.moving_part_geometry import PartPlane
 from capt_env.wrappers.refiners.draft import Draft
 
@@ -82,8 +82,22 @@ class Handle:
         if not handles:
             return False
         draft.grasp, draft.from_handle = handles[0].point, True
-        draft.other_handles = [g.point for g in handles[1:]]
+        draft.other_handles = [g.point for g in handles[1:] if twin(g, handles[0])]
         return True
+
+
+TWIN_BAR_ANGLE = np.radians(20.0)
+"""rad: two bars this near parallel can be a double door's pair."""
+
+
+def twin(other: GraspCandidate, handle: GraspCandidate) -> bool:
+    """Whether ``other`` could be the twin of ``handle`` on the other leaf of a double door: the same
+    kind, and for bars, bars near parallel (the two leaves of a double door carry the same handle,
+    mirrored; a lock knob beside a lever, or a lever seen beside another piece of an open door, is not
+    one)."""
+    if other.kind != handle.kind:
+        return False
+    return other.kind != "bar" or abs(float(other.bar_axis @ handle.bar_axis)) >= np.cos(TWIN_BAR_ANGLE)
 
 
 def over_part(point: np.ndarray, part_points: np.ndarray, plane: PartPlane, margin: float) -> bool:
