@@ -44,8 +44,8 @@ class Draft:
     The estimate: ``joint_type``, ``direction`` (3,) unit, ``pivot`` (3,) a point on the line,
     ``state`` (rad or m), ``confidence``, ``grasp`` (3,) or None until a handle is found or the
     grasp is settled (:meth:`settle_grasp`), ``from_handle`` (the grasp point is on a handle),
-    ``other_handles`` the other handles found on the panel (each (3,)). ``fired`` lists the refiners
-    that changed the draft, in order.
+    ``other_handles`` the other handles found on the panel that could be the grasp's twin on a double
+    door's other leaf (each (3,)). ``fired`` lists the refiners that changed the draft, in order.
     """
 
     points: np.ndarray
