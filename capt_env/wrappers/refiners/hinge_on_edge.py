@@ -2,9 +2,10 @@
 
 Geometric reason: a closed door, lid or oven door turns about a line in (or just behind) its own
 plane along its edge farthest from the handle. A panel with a twin of the grasp's handle beside it
-(:func:`~capt_env.wrappers.refiners.handle.twin`), at its height, is two coplanar doors meeting between their handles (a double door the network reads as
-one part; Franka Kitchen's hinged cabinet): the grasp's door is hinged on the panel's edge on its
-side of that seam (``pair_doors``). The direction is projected into the part's plane
+(:func:`~capt_env.wrappers.refiners.handle.twin`), at its height, is two coplanar doors meeting
+between their handles (a double door the network reads as one part; Franka Kitchen's hinged
+cabinet): the grasp's door is hinged on the panel's edge on its side of that seam (``pair_doors``).
+The direction is projected into the part's plane
 (its in-plane component kept, so the network still decides which edge), and the network's line is
 kept when it lies within ``tolerance`` of that edge and of the plane, else it is put on the edge
 (the ``edge_quantile`` of the ``panel``'s points across the axis). On a real microwave the
