@@ -27,8 +27,8 @@ USER_GRASP_MAX_Y: float = 0.2
 noise, by the least distance that brings its closed grasp target into x in ``USER_GRASP_X`` and
 |y| <= ``USER_GRASP_MAX_Y``: the span of the procedural instances' grasp targets at their placements
 (x 0.02-0.24, |y| <= 0.2), where the opener was developed. A large file centred at 0.3 m can leave
-its handle under the resting hand (Franka Kitchen's hinged cabinet, 60 cm deep: x -0.08) or 30-40
-cm to the side (its microwave and sliding cabinet), where the Panda's wrist cannot turn with the
+its handle under the resting hand (Franka Kitchen's hinged cabinet, 60 cm deep: x -0.08) or 40 cm
+to the side (its sliding cabinet), where the Panda's wrist cannot turn with the
 part."""
 
 
