@@ -5,7 +5,9 @@ point in cm), for finding which situation an opening fails in (development seeds
     python scripts/trace_opener_episode.py --objects data/real_objects/corpus.yaml --name mw_window \
         --seed 100 --every 5 --json /tmp/trace.json
 
-Prints one line every ``--every`` steps and at each phase change; ``--json`` keeps every step.
+Prints one line every ``--every`` steps and at each phase change; ``--json`` keeps every step. Each
+step also records which bodies touch the moving part (``contacts``: the simulator's contacts with a
+non-zero impulse), which tells a hand that slipped from one pushed off by its own palm or arm.
 """
 
 from __future__ import annotations
@@ -84,12 +86,14 @@ def main() -> None:
                "error": {"direction_deg": round(err["direction_deg"], 1),
                          "line_cm": None if err["line_m"] is None else round(100 * err["line_m"], 1),
                          "grasp_cm": round(100 * err["grasp_m"], 1)}}
+        row["contacts"] = part_contacts(env)
         steps.append(row)
         if opener.phase.value != last_phase or step % args.every == 0:
             print(f"{step:4d} {row['phase']:9s} tcp {row['tcp']} gap {row['gap']:.4f} "
                   f"state {row['state']:+.3f} open {row['open_fraction']:.2f} ok {int(row['success'])} "
                   f"grasp {row['grasp']} err {row['error']} "
-                  f"act {row['action']} appr {row['approach']} clos {row['closing']} arm {row['arm']}")
+                  f"act {row['action']} appr {row['approach']} clos {row['closing']} arm {row['arm']} "
+                  f"touching {row['contacts']}")
             if opener.phase.value == "approach" and last_phase != "approach":
                 print("     rehearsals (nearer, other):", opener.rehearsals)
             last_phase = opener.phase.value
@@ -100,6 +104,18 @@ def main() -> None:
         with open(args.json, "w") as fh:
             json.dump({"steps": steps, "phase_log": opener.phase_log}, fh)
     env.close()
+
+
+def part_contacts(env) -> list[str]:
+    """Names of the bodies touching the target joint's moving link now (sub-scene 0), sorted."""
+    base = env.unwrapped
+    part = base.object.joints[base.object.target_joint].child_link.name
+    touching = set()
+    for contact in base.scene.get_contacts():
+        a, b = (body.entity.name for body in contact.bodies)
+        if part in (a, b) and any(np.linalg.norm(point.impulse) > 1e-4 for point in contact.points):
+            touching.add(b if a == part else a)
+    return sorted(touching)
 
 
 if __name__ == "__main__":

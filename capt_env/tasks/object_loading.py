@@ -181,7 +181,8 @@ def _load_user_file(scene: Any, cfg: TaskConfig) -> LoadedObject:
     front = cfg.front_yaw_radians()
     if front is None:
         front = _guess_front_azimuth(art, grasp_link, grasp, aabb)
-    grasp_closed = _pose_matrix(grasp_link.pose)[:3, :3] @ grasp.point + _pose_matrix(grasp_link.pose)[:3, 3]
+    link_pose = _pose_matrix(grasp_link.pose)
+    grasp_closed = link_pose[:3, :3] @ grasp.point + link_pose[:3, 3]
     shift = ((0.0, 0.0) if cfg.object_xy is not None
              else grasp_reach_shift(grasp_closed, aabb, float(math.pi - front), cfg.placement_xy()))
     return LoadedObject(
