@@ -194,6 +194,24 @@ class Hinged(PartStrategy):
         return perpendicular(approach, est.grasp_point - est.pivot)
 
 
+LEVEL_CLOSING_SINE = 0.5
+"""Fingers whose closing direction rises less than 30 deg (this sine) from level close level, across
+an upright bar; a side door's grasp closes either level (across a bar along the hinge) or, turned a
+quarter turn across a level bar (a lever), at the approach's pitch from vertical (44 deg at 0.8 rad)."""
+
+PALM_CLEAR_PITCH = float(np.arctan2(0.0374, 0.0316))
+"""rad (0.87): below this pitch below level, an upright bar held at the TCP between level-closing
+fingers passes outside the palm: the Panda hand's collision mesh ends 3.74 cm behind the TCP and
+spans 3.16 cm either side of the fingers' plane, and at pitch p the bar runs 3.74 / tan(p) cm across
+that plane there. ``side_door.pitch`` (0.8) lies below it."""
+
+
+def closes_across_level_bar(r: np.ndarray) -> bool:
+    """Whether a TCP rotation ``r`` (3, 3; its y the closing direction) has fingers that close across
+    a level bar: the closing direction rises at least 30 deg from level (:data:`LEVEL_CLOSING_SINE`)."""
+    return abs(float(r[2, 1])) >= LEVEL_CLOSING_SINE
+
+
 class SideDoor(Hinged):
     """A door on a hinge within ``side_door.max_tilt`` of vertical (:func:`~agents.scripted.grasp_pose.
     is_vertical_hinge`): grasped as any hinged part, pitched ``side_door.pitch`` down (the hand has
@@ -215,12 +233,16 @@ class SideDoor(Hinged):
         """``r`` pitched down to ``side_door.pitch`` plus ``side_door.pull_roll`` times the angle
         ``turned`` (rad) beyond ``side_door.pull_roll_from``, at most ``side_door.max_pull_pitch``,
         about the horizontal axis across its approach (:func:`~agents.scripted.grasp_pose.
-        pitched_down`): a hand square to a door swung far round has its wrist out beyond the door,
-        where the arm runs out of reach. That axis is the line between the fingertips of a hand
-        closing level (across a vertical bar) and the bar of one closing across a level bar (a
-        lever): either way the grip turns about what it holds."""
+        pitched_down`), when the fingers close across a level bar (:func:`closes_across_level_bar`):
+        a hand square to a door swung far round has its wrist out beyond the door, where the arm runs
+        out of reach. That axis is then the bar itself, and the grip turns about what it holds. A
+        hand whose fingers close level holds an upright bar (a side door's bar runs along its hinge),
+        and that axis is the line between its fingertips: pitching turns the bar in the grip, and
+        past :data:`PALM_CLEAR_PITCH` the bar's upper end meets the palm, which pushes the door and
+        prises the bar out of the fingers (Franka Kitchen's microwave, whose bar runs the door's
+        height). Such a hand keeps ``r``."""
         beyond = turned - self.own.pull_roll_from
-        if self.own.pull_roll <= 0.0 or beyond <= 0.0:
+        if self.own.pull_roll <= 0.0 or beyond <= 0.0 or not closes_across_level_bar(r):
             return r
         return pitched_down(r, min(self.own.pitch + self.own.pull_roll * beyond, self.own.max_pull_pitch))
 

@@ -13,6 +13,7 @@ from agents.scripted.geometry import axis_angle_matrix
 from agents.scripted.grasp_pose import grasp_rotation, grasp_target, part_kind, quarter_turn
 from agents.scripted.opener import ACTION_SCALE_M, Phase
 from agents.scripted.part_strategies import (
+    PALM_CLEAR_PITCH,
     STRATEGIES,
     Drawer,
     FallingDoor,
@@ -20,6 +21,7 @@ from agents.scripted.part_strategies import (
     Lid,
     SideDoor,
     SlidingPanel,
+    closes_across_level_bar,
     strategy_for,
 )
 from agents.scripted.phases.base import Look
@@ -148,9 +150,10 @@ def _elevation(v: np.ndarray) -> float:
     return float(np.arcsin(np.clip(v[2], -1.0, 1.0)))
 
 
-def test_a_side_door_s_pull_pitches_the_hand_down_as_the_door_turns_about_what_it_holds() -> None:
+def test_a_side_door_s_pull_pitches_the_hand_down_about_a_level_bar_it_holds() -> None:
     door, own = SideDoor(CFG), CFG.side_door
-    grasp = door.grasp_rotation(_side_door(), np.eye(3))
+    grasp = quarter_turn(door.grasp_rotation(_side_door(), np.eye(3)), np.eye(3))
+    assert closes_across_level_bar(grasp)
     np.testing.assert_allclose(door.pull_rotation(grasp, 0.0), grasp)
     # nearer closed than pull_roll_from the hand stays square to the door
     np.testing.assert_allclose(door.pull_rotation(grasp, 0.9 * own.pull_roll_from), grasp)
@@ -159,18 +162,37 @@ def test_a_side_door_s_pull_pitches_the_hand_down_as_the_door_turns_about_what_i
         rolled = door.pull_rotation(held, turned)
         want = min(own.pitch + own.pull_roll * max(turned - own.pull_roll_from, 0.0), own.max_pull_pitch)
         assert _elevation(rolled[:, 2]) == pytest.approx(-want)
-        # fingers closing level (across a vertical bar) turn about the line between their tips
-        np.testing.assert_allclose(rolled[:, 1], held[:, 1], atol=1e-9)
-    # fingers turned a quarter to close across a level bar (a lever) turn about the bar
-    lever = quarter_turn(grasp, grasp)
-    rolled = door.pull_rotation(lever, 1.5)
-    np.testing.assert_allclose(rolled[:, 0], lever[:, 0], atol=1e-9)
-    assert _elevation(rolled[:, 2]) < _elevation(lever[:, 2]) - 0.3
+        # fingers closing across a level bar (a lever) turn about the bar
+        np.testing.assert_allclose(rolled[:, 0], held[:, 0], atol=1e-9)
     # off, and no other kind of part rolls its hand
     off = SideDoor(with_options(CFG, side_door__pull_roll=0.0))
     np.testing.assert_allclose(off.pull_rotation(grasp, 1.5), grasp)
     for other in (Hinged, Lid, FallingDoor, Drawer):
         np.testing.assert_allclose(other(CFG).pull_rotation(grasp, 1.5), grasp)
+
+
+def test_a_hand_holding_an_upright_bar_keeps_its_pitch_so_the_bar_stays_off_its_palm() -> None:
+    door = SideDoor(CFG)
+    grasp = door.grasp_rotation(_side_door(), np.eye(3))  # fingers close level, across a bar along the hinge
+    assert not closes_across_level_bar(grasp)
+    for turned in (1.2, 1.5, 2.0):
+        held = axis_angle_matrix(Z, turned) @ grasp
+        np.testing.assert_allclose(door.pull_rotation(held, turned), held)
+    # the pitch it keeps passes an upright bar outside the palm
+    assert CFG.side_door.pitch < PALM_CLEAR_PITCH
+
+
+def test_the_palm_clear_pitch_is_the_panda_hand_s_own_geometry() -> None:
+    trimesh = pytest.importorskip("trimesh")
+    from pathlib import Path
+
+    from mani_skill.agents.robots.panda.panda import Panda
+
+    mesh = trimesh.load(Path(Panda.urdf_path).parent / "franka_description/meshes/collision/hand.stl")
+    tcp_depth = 0.1034  # panda_hand_tcp_joint: the TCP lies this far along the hand's z
+    behind = tcp_depth - float(mesh.vertices[:, 2].max())  # the palm's end nearest the TCP
+    half_thickness = float(np.abs(mesh.vertices[:, 0]).max())  # across the fingers' plane
+    assert PALM_CLEAR_PITCH == pytest.approx(np.arctan2(behind, half_thickness), abs=0.01)
 
 
 def test_a_door_that_falls_open_is_grasped_as_any_hinge_and_said_to_fall() -> None:

@@ -602,13 +602,16 @@ def _side_door_pull_begun(cfg: ScriptedOpenerConfig) -> tuple[ScriptedOpener, Jo
     return opener, closed, rot
 
 
-def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: float) -> ScriptedOpener:
+def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: float,
+                          seen: float | None = None) -> ScriptedOpener:
     """An opener that grasped a closed door on a vertical hinge (:func:`_side_door_pull_begun`) and
-    whose hand, fingers ``finger_gap`` m apart, stopped with the door ``state`` rad open."""
+    whose hand, fingers ``finger_gap`` m apart, stopped ``state`` rad round the hinge, the door seen
+    ``seen`` rad open (``state`` when None)."""
     opener, closed, rot = _side_door_pull_begun(cfg)
     u, pivot = closed.direction, closed.pivot
     turn = axis_angle_matrix(u, state)
-    est = JointAxisEstimate("revolute", u, pivot, state, pivot + turn @ (closed.grasp_point - pivot))
+    est = JointAxisEstimate("revolute", u, pivot, state if seen is None else seen,
+                            pivot + turn @ (closed.grasp_point - pivot))
     at = _pose(turn @ rot, est.grasp_point)
     for _ in range(cfg.pull.stall_steps + 2):
         opener.act_on(est, at, finger_gap=finger_gap)
@@ -624,11 +627,23 @@ def test_a_side_door_held_far_open_that_stalls_is_at_its_stop() -> None:
     assert far < cfg.pull.revolute.target
     opener = _side_door_stalled_at(far, cfg, finger_gap=0.02)
     assert not opener.ctx.grasp_again and opener.regrasps == 0
-    # nearer closed, with the fingers closed on nothing, or with the option off: grasp again
-    for state, gap, config in ((cfg.pull.revolute.stop_above - 0.3, 0.02, cfg), (far, 0.0, cfg),
-                               (far, 0.02, _cfg(pull__revolute__stop_above=0.0))):
-        opener = _side_door_stalled_at(state, config, finger_gap=gap)
-        assert opener.ctx.grasp_again and opener.regrasps == 1, (state, gap)
+    # nearer closed, or with the option off: grasp again
+    for state, config in ((cfg.pull.revolute.stop_above - 0.3, cfg),
+                          (far, _cfg(pull__revolute__stop_above=0.0))):
+        opener = _side_door_stalled_at(state, config, finger_gap=0.02)
+        assert opener.ctx.grasp_again and opener.regrasps == 1, state
+
+
+def test_a_side_door_at_its_stop_whose_handle_slid_out_of_the_fingers_is_left_open() -> None:
+    # the hand carried on round the arc past the stopped door and its fingers closed on nothing; the
+    # door is seen far open too: reaching for its handle again would knock it back
+    cfg = ScriptedOpenerConfig()
+    far = cfg.pull.revolute.stop_above + 0.1
+    opener = _side_door_stalled_at(far, cfg, finger_gap=0.0)
+    assert not opener.ctx.grasp_again and opener.regrasps == 0
+    # fingers that slid along the handle carried the hand ahead of a door seen nearer closed: grasp again
+    opener = _side_door_stalled_at(far, cfg, finger_gap=0.0, seen=cfg.pull.revolute.stop_above - 0.3)
+    assert opener.ctx.grasp_again and opener.regrasps == 1
 
 
 def _drawer_slipped_at(stop_at: float, cfg: ScriptedOpenerConfig) -> ScriptedOpener:

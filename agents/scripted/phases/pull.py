@@ -117,10 +117,14 @@ class Pull(OpenerPhase):
                 # hand and the perception must say so: fingers slipping along the handle carry the
                 # hand round the arc ahead of the door
                 ctx.grasp_again = False
-            if (stalled and revolute and grip.stall_can_be_end_stop and not falls and holding
-                    and not wrist_stuck and 0.0 < cfg.pull.revolute.stop_above <= state):
-                # held far open and the arm still in range: the part is at its end stop, and reaching
-                # for the handle again would knock it back
+            stop_above = cfg.pull.revolute.stop_above
+            if (stalled and revolute and grip.stall_can_be_end_stop and not falls
+                    and 0.0 < stop_above <= state
+                    and (not wrist_stuck if holding else stop_above <= float(est.state))):
+                # far open: the part is at its end stop, and reaching for the handle again would knock
+                # it back. Held, the hand's measure says so unless a wrist joint at its limit stopped
+                # the arm; let go, the hand carried on along the arc past the stopped part and slid
+                # off its handle (pinning the wrist as it went), so the part as seen must say so too
                 ctx.grasp_again = False
             ctx.regrasps += int(ctx.grasp_again)
             ctx.let_go_state = state
