@@ -377,12 +377,13 @@ class SideDoorConfig:
     pitch: float = 0.8
     """The approach points at least this far below horizontal (rad)."""
     pull_roll: float = 0.8
-    """While pulling, past ``pull_roll_from``, the hand pitches further down by this share of the
-    further angle the door turns (rad per rad), turning about the horizontal axis across its
-    approach (the line between its fingertips, or the level bar they close across: the grip turns
-    about what it holds), up to ``max_pull_pitch``: a hand square to a door swung far round points
-    away from the robot, its wrist out beyond the door and the arm at the edge of its reach; pitched
-    down, the wrist stays over the handle. 0: off."""
+    """While pulling, past ``pull_roll_from``, a hand whose fingers close across a level bar (a lever)
+    pitches further down by this share of the further angle the door turns (rad per rad), turning
+    about the horizontal axis across its approach, which is that bar (the grip turns about what it
+    holds), up to ``max_pull_pitch``: a hand square to a door swung far round points away from the
+    robot, its wrist out beyond the door and the arm at the edge of its reach; pitched down, the
+    wrist stays over the handle. A hand closing level, across an upright bar, keeps its pitch (the
+    roll would turn the bar into its palm). 0: off."""
     max_pull_pitch: float = 1.2
     """The roll stops at this pitch below horizontal (rad)."""
     pull_roll_from: float = 1.0
