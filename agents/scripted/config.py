@@ -386,6 +386,14 @@ class SideDoorConfig:
     roll would turn the bar into its palm). 0: off."""
     max_pull_pitch: float = 1.2
     """The roll stops at this pitch below horizontal (rad)."""
+    upright_bar_follow: float = 0.8
+    """A hand whose fingers close level, across an upright bar (a bar along the hinge), turns by this
+    share of the door's angle while pulling; one closed across a level bar (a lever) turns fully. The
+    bar spins about its own axis between the pads, and the hand, lagging the door, keeps its wrist
+    nearer the robot: the reach the roll gives a hand across a level bar, which this hand cannot take
+    (the roll would turn the bar into its palm). On the Panda's kinematics, a handle 37 cm from the
+    hinge is followed to 1.5 rad at 0.8 and falls short near 1.45 rad turning fully
+    (``tests/agents/test_side_door_reach.py``)."""
     pull_roll_from: float = 1.0
     """The roll starts once the door has turned this far (rad): nearer closed the arm has reach to
     spare, and a hand square to the door holds its handle best (each turn of the hand moves the pads on
@@ -396,6 +404,8 @@ class SideDoorConfig:
         _angle(self.pitch, "side_door.pitch")
         require(self.pull_roll >= 0.0, f"side_door.pull_roll must be >= 0 rad/rad, got {self.pull_roll}")
         _angle(self.max_pull_pitch, "side_door.max_pull_pitch")
+        require(0.0 <= self.upright_bar_follow <= 1.0,
+                f"side_door.upright_bar_follow must be in [0, 1], got {self.upright_bar_follow}")
         require(self.pull_roll_from >= 0.0,
                 f"side_door.pull_roll_from must be >= 0 rad, got {self.pull_roll_from}")
 

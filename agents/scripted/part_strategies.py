@@ -149,12 +149,16 @@ class PartStrategy(ABC):
         door reaches the Panda's wrist limit)."""
         return self.cfg.pull.revolute.wrist_follow
 
-    def hand_turn(self, est: JointAxisEstimate, lifting: bool) -> float:
-        """The share of the part's angle the hand turns by while pulling about ``est``'s hinge: fully
-        about a hinge ``est`` shows vertical (a side door's: the wrist has room, and the handle stays
-        square in the fingers), else :meth:`wrist_follow`. Read from the look at hand, not from the
-        kind of the grasp: the hinge seen while pulling is the one the hand follows."""
-        return FULL_TURN if is_vertical_hinge(est, self.cfg) else self.wrist_follow(lifting)
+    def hand_turn(self, est: JointAxisEstimate, lifting: bool, grasp_r: np.ndarray) -> float:
+        """The share of the part's angle the hand turns by while pulling about ``est``'s hinge, for a
+        grasp with TCP rotation ``grasp_r`` (3, 3). About a hinge ``est`` shows vertical (a side
+        door's: the wrist has room): fully for a hand closed across a level bar (a lever stays square
+        in the fingers), ``side_door.upright_bar_follow`` for one closing level, across an upright bar
+        (:func:`closes_across_level_bar`); else :meth:`wrist_follow`. Read from the look at hand, not
+        from the kind of the grasp: the hinge seen while pulling is the one the hand follows."""
+        if not is_vertical_hinge(est, self.cfg):
+            return self.wrist_follow(lifting)
+        return FULL_TURN if closes_across_level_bar(grasp_r) else self.cfg.side_door.upright_bar_follow
 
     def inward(self, lifting: bool) -> float:
         """How far (m per radian turned) the pulling hand moves towards the hinge off the arc: 0."""
@@ -215,7 +219,7 @@ def closes_across_level_bar(r: np.ndarray) -> bool:
 class SideDoor(Hinged):
     """A door on a hinge within ``side_door.max_tilt`` of vertical (:func:`~agents.scripted.grasp_pose.
     is_vertical_hinge`): grasped as any hinged part, pitched ``side_door.pitch`` down (the hand has
-    room to turn fully with the door, so it can start pitched further); the hand turns fully with it
+    room to turn with the door, so it can start pitched further); the hand turns with it
     (:meth:`PartStrategy.hand_turn`)."""
 
     name = "side_door"

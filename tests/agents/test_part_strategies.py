@@ -131,7 +131,7 @@ def test_a_lid_s_slip_leaves_out_travel_along_its_hinge() -> None:
     np.testing.assert_allclose(SideDoor(CFG).slip_offset(away, Y), away)
 
 
-def test_a_side_door_is_pitched_further_and_the_hand_turns_fully_with_it() -> None:
+def test_a_side_door_is_pitched_further_and_the_hand_turns_with_it() -> None:
     door = strategy_for(_side_door(), CFG)
     assert door.pitch == CFG.side_door.pitch
     rot = door.grasp_rotation(_side_door(), np.eye(3))
@@ -140,9 +140,12 @@ def test_a_side_door_is_pitched_further_and_the_hand_turns_fully_with_it() -> No
     pitch = CFG.side_door.pitch
     np.testing.assert_allclose(rot[:, 2], [np.cos(pitch), 0.0, -np.sin(pitch)], atol=1e-9)
     assert abs(float(rot[:, 1] @ Y)) == pytest.approx(1.0)
-    assert door.hand_turn(_side_door(), lifting=False) == 1.0
+    # a hand across a level bar (a lever) turns fully with the door, one across an upright bar lags it
+    lever = quarter_turn(rot, rot)
+    assert door.hand_turn(_side_door(), lifting=False, grasp_r=lever) == 1.0
+    assert door.hand_turn(_side_door(), lifting=False, grasp_r=rot) == CFG.side_door.upright_bar_follow < 1.0
     # the hinge the look shows decides: a door grasped as a side door, seen tilted, turns by the share
-    assert door.hand_turn(_oven(), lifting=False) == CFG.pull.revolute.wrist_follow
+    assert door.hand_turn(_oven(), lifting=False, grasp_r=rot) == CFG.pull.revolute.wrist_follow
     assert door.pull_target(revolute=True) == CFG.pull.revolute.target and door.stall_can_be_end_stop
 
 
@@ -201,7 +204,7 @@ def test_a_door_that_falls_open_is_grasped_as_any_hinge_and_said_to_fall() -> No
     np.testing.assert_allclose(oven.grasp_rotation(_oven(), np.eye(3)),
                                Hinged(CFG).grasp_rotation(_oven(), np.eye(3)), atol=1e-12)
     assert oven.pitch == flap.pitch == CFG.approach.pitch
-    assert oven.hand_turn(_oven(), lifting=False) == CFG.pull.revolute.wrist_follow
+    assert oven.hand_turn(_oven(), lifting=False, grasp_r=np.eye(3)) == CFG.pull.revolute.wrist_follow
     assert oven.own is CFG.falling_door
 
 
