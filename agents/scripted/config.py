@@ -219,8 +219,8 @@ class RevolutePullConfig:
     """A pull that turned less than this (rad) over ``pull.stall_steps`` has stalled (a limit, a lost
     grip)."""
     wrist_follow: float = 0.5
-    """The hand turns by this share of the part's angle about a hinge that is not vertical (a side door's
-    hand turns fully): a grasped bar turns between the pads, and a hand turned fully with an oven door
+    """The hand turns by this share of the part's angle about a hinge that is not vertical (a side
+    door's: ``side_door.upright_bar_follow`` or fully): a grasped bar turns between the pads, and a hand turned fully with an oven door
     reaches the Panda's wrist limit."""
     stop_above: float = 1.4
     """A hinged part (not a lid nor a door that falls open) whose pull stalls past this angle (rad), the
@@ -369,8 +369,9 @@ class RecoveryConfig:
 
 @dataclass(frozen=True)
 class SideDoorConfig:
-    """A door hinged about a near-vertical axis: the hand only yaws while pulling, so it turns fully with
-    the door and can start pitched further down."""
+    """A door hinged about a near-vertical axis: the hand only yaws while pulling, so it turns with the
+    door (fully across a level bar, by ``upright_bar_follow`` across an upright one) and can start
+    pitched further down."""
 
     max_tilt: float = 0.8
     """A hinge within this (rad) of vertical is a side door's."""
