@@ -220,8 +220,8 @@ class RevolutePullConfig:
     grip)."""
     wrist_follow: float = 0.5
     """The hand turns by this share of the part's angle about a hinge that is not vertical (a side
-    door's: ``side_door.upright_bar_follow`` or fully): a grasped bar turns between the pads, and a hand turned fully with an oven door
-    reaches the Panda's wrist limit."""
+    door's turns by ``side_door.upright_bar_follow`` or fully): a grasped bar turns between the pads,
+    and a hand turned fully with an oven door reaches the Panda's wrist limit."""
     stop_above: float = 1.4
     """A hinged part (not a lid nor a door that falls open) whose pull stalls past this angle (rad), the
     fingers holding and no wrist joint at its limit, is at its end stop and is not grasped again (0:

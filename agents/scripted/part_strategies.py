@@ -48,7 +48,7 @@ from agents.scripted.grasp_pose import (
 )
 from capt_env.wrappers.estimate import JointAxisEstimate, unit
 
-FULL_TURN = 1.0  # share of a side door's angle its hand turns by
+FULL_TURN = 1.0  # share of a side door's angle a hand across a level bar turns by
 
 
 class PartStrategy(ABC):
