@@ -34,7 +34,7 @@ from agents.scripted.config import (
     SideDoorConfig,
     SlidingPanelConfig,
 )
-from agents.scripted.geometry import grasp_frame, off_axis, perpendicular
+from agents.scripted.geometry import axis_angle_matrix, grasp_frame, off_axis, perpendicular
 from agents.scripted.grasp_pose import (
     UP,
     falls_open,
@@ -159,6 +159,15 @@ class PartStrategy(ABC):
         if not is_vertical_hinge(est, self.cfg):
             return self.wrist_follow(lifting)
         return FULL_TURN if closes_across_level_bar(grasp_r) else self.cfg.side_door.upright_bar_follow
+
+    def pulling_rotation(self, est: JointAxisEstimate, lifting: bool, grasp_r: np.ndarray, u: np.ndarray,
+                         delta: float, turned: float) -> np.ndarray:
+        """The pulling hand's rotation (3, 3) about a hinge along unit ``u`` (3,): the grasp rotation
+        ``grasp_r`` (3, 3) turned by :meth:`hand_turn`'s share of ``delta`` (rad along the arc the hand
+        is sent to), then :meth:`pull_rotation` for the part turned ``turned`` rad since the grasp.
+        The pull and the finger-order rehearsal both ask this."""
+        follow = self.hand_turn(est, lifting, grasp_r)
+        return self.pull_rotation(axis_angle_matrix(u, follow * delta) @ grasp_r, turned)
 
     def inward(self, lifting: bool) -> float:
         """How far (m per radian turned) the pulling hand moves towards the hinge off the arc: 0."""

@@ -44,11 +44,10 @@ def _pull_error(cfg: ScriptedOpenerConfig, angle: float, quarter: bool) -> float
         for _ in range(3):
             q = ik_step(q, pose_matrix(start[:3, 3] + share * (HANDLE - BASE - start[:3, 3]), r0))
     err = np.zeros(6)
-    follow = door.hand_turn(est, lifting=False, grasp_r=r0)
     for turned in np.arange(0.05, angle + 1e-9, 0.05):
         turn = axis_angle_matrix(HINGE_AXIS, turned)
-        hand = axis_angle_matrix(HINGE_AXIS, follow * turned) @ r0
-        goal = pose_matrix(HINGE + turn @ (HANDLE - HINGE) - BASE, door.pull_rotation(hand, turned))
+        hand = door.pulling_rotation(est, False, r0, HINGE_AXIS, turned, turned)
+        goal = pose_matrix(HINGE + turn @ (HANDLE - HINGE) - BASE, hand)
         for _ in range(3):
             q = ik_step(q, goal)
         err = pose_error(goal, tcp_pose(q))

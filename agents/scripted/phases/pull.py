@@ -227,9 +227,8 @@ def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u:
         # pushing from below, the fingertips stay pressed into the lid's front face from wherever
         # they are: the estimated arc alone runs off the face as the lid turns
         p_des = pressed(p_des, p, pivot, u, press)
-    follow = grip.hand_turn(est, ctx.lift, track.grasp_r)
     turned = state - track.grasp_state
-    return p_des, grip.pull_rotation(axis_angle_matrix(u, follow * delta) @ track.grasp_r, turned)
+    return p_des, grip.pulling_rotation(est, ctx.lift, track.grasp_r, u, delta, turned)
 
 
 def pressed(p_des: np.ndarray, p: np.ndarray, pivot: np.ndarray, u: np.ndarray, press: float) -> np.ndarray:

@@ -293,10 +293,9 @@ def rehearse_grasp(ctx: OpenerContext, kind: PartStrategy, est: JointAxisEstimat
     revolute = est.joint_type == "revolute"
     target = kind.pull_target(revolute)
     if revolute:
-        follow = kind.hand_turn(est, lifting=False, grasp_r=rotation)
         for delta in np.arange(0.05, max(target - float(est.state), 0.0) + 1e-9, 0.05):
             path.append((est.pivot + axis_angle_matrix(u, delta) @ (grasp_at - est.pivot),
-                         kind.pull_rotation(axis_angle_matrix(u, follow * delta) @ rotation, delta)))
+                         kind.pulling_rotation(est, False, rotation, u, delta, delta)))
     else:
         for delta in np.arange(0.01, max(target - float(est.state), 0.0) + 1e-9, 0.01):
             path.append((grasp_at + u * delta, rotation))
