@@ -76,7 +76,15 @@ def main() -> None:
             print("rehearsals (nearer, other):", opener.rehearsals)
         obs, _, _, truncated, info = env.step(action)
         row = {"step": step, "phase": opener.phase.value, "tcp": tcp[:3].round(4).tolist(),
-               "gap": round(float(qpos[7] + qpos[8]), 4), "state": round(float(est.state), 4),
+               "gap": round(float(qpos[7] + qpos[8]), 4),
+               "pull_pivot": (None if opener.ctx.pull.grasp_pivot is None else np.round(
+                   opener.ctx.pull.hinge_fit if opener.ctx.pull.hinge_fit is not None
+                   else opener.ctx.pull.grasp_pivot, 4).tolist()),
+               "arc_fitted": opener.ctx.pull.hinge_fit is not None,
+               "fingers": [round(float(qpos[7]), 4), round(float(qpos[8]), 4)],
+               "handle_in_hand": np.round(quat_to_matrix(tcp[3:7]).T
+                                          @ (ground_truth_estimate(info).grasp_point - tcp[:3]), 4).tolist(),
+               "state": round(float(est.state), 4),
                "grasp": np.round(est.grasp_point, 4).tolist(),
                "open_fraction": round(float(info["open_fraction"]), 3), "success": bool(info["success"]),
                "action": np.round(action, 2).tolist(),

@@ -171,10 +171,15 @@ def run(args: argparse.Namespace) -> int:
 
         band = HandleConfig()
         note = ""
-        if standoff > band.max_standoff:
+        far = max(band.max_standoff, band.far_standoff)
+        if standoff > far:
             note = (f": beyond the band CAPT's handle search looks in ({100 * band.min_standoff:.1f}-"
-                    f"{100 * band.max_standoff:.0f} cm off the face): with CAPT the grasp may fall back "
+                    f"{100 * far:.0f} cm off the face): with CAPT the grasp may fall back "
                     "to another piece or the part's edge")
+        elif standoff > band.max_standoff:
+            note = (f": beyond CAPT's first handle search ({100 * band.min_standoff:.1f}-"
+                    f"{100 * band.max_standoff:.0f} cm off the face), found only when nothing stands "
+                    f"in that band (the second looks out to {100 * far:.0f} cm)")
         print(f"handle: its grip stands {100 * standoff:.1f} cm off the part's face{note}")
     verdict = "in reach" if reach["ok"] else "OUT OF REACH: move it (object_xy) or scale it"
     print(f"reach from the Panda's shoulder: closed {reach['closed_m']:.2f} m, opened to "

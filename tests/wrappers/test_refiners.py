@@ -202,6 +202,34 @@ def test_only_a_matching_handle_counts_as_the_other_leaf_of_a_double_door() -> N
     assert twin(cand("knob", (0.0, 1.0, 0.0)), cand("knob", (0.0, 0.0, 1.0)))  # knobs: no axis to match
 
 
+def _door_with_bars(rng: np.random.Generator, *standoffs: float) -> tuple[np.ndarray, np.ndarray]:
+    """``_door`` without its bar, and one upright 10 cm bar per standoff (m out of the face, which
+    faces -x at x = -0.2), at y = 0.16 and then 10 cm further towards the hinge each."""
+    points, labels = _door(rng, handle=False)
+    bars = [np.column_stack([np.full(40, -0.2 - off), np.full(40, 0.16 - 0.1 * k),
+                             rng.uniform(0.15, 0.25, 40)]) for k, off in enumerate(standoffs)]
+    return np.concatenate([points, *bars]), np.concatenate([labels, np.ones(40 * len(bars), int)])
+
+
+def test_a_bar_on_long_posts_is_found_by_the_second_wider_search() -> None:
+    # a bar 10 cm off its face (past the usual 1.2-8 cm band; Franka Kitchen's microwave)
+    points, labels = _door_with_bars(np.random.default_rng(0), 0.10)
+    draft = _draft(points, labels, _hinge())
+    assert Handle().refine(draft) and draft.grasp is not None
+    np.testing.assert_allclose(draft.grasp[1:], [0.16, 0.2], atol=0.01)
+    assert draft.grasp[0] < -0.28  # on the bar, not the face
+    # with the second search off, nothing is found in the usual band
+    from capt_env.wrappers.refiners.handle import HandleConfig
+    assert not Handle(HandleConfig(far_standoff=0.0)).refine(_draft(points, labels, _hinge()))
+
+
+def test_a_handle_in_the_usual_band_outranks_anything_standing_farther_out() -> None:
+    points, labels = _door_with_bars(np.random.default_rng(0), 0.11, 0.03)
+    draft = _draft(points, labels, _hinge())
+    assert Handle().refine(draft) and draft.grasp is not None
+    np.testing.assert_allclose(draft.grasp[1:], [0.06, 0.2], atol=0.01)  # the 3 cm bar
+
+
 def test_handle_does_not_fire_on_a_door_without_one() -> None:
     points, labels = _door(np.random.default_rng(0), handle=False)
     draft = _draft(points, labels, _hinge())

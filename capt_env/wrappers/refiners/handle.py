@@ -13,6 +13,11 @@ bar is centred across its thickness too (the cameras see one side of it), and it
 its thickness behind its front (the posts that hold it off the face pull a centroid behind it),
 except on a part swinging about a horizontal hinge (an oven door, a lid): measured, that moved an
 oven's grasp point off its bar.
+When nothing stands in that band, the search runs again out to ``far_standoff`` (13 cm): a bar on
+long posts stands farther out (Franka Kitchen's microwave: a 2 cm bar on 5.8 cm posts, seen 9-12 cm
+off the plane fitted to its door, whose glass lies behind the door's front), and a second search only
+where the first found nothing never lets something standing farther out (a frame, a neighbouring
+part) outrank a handle in the usual band.
 The face is the part's plane (:attr:`Draft.face`): a drawer's front, facing along its slide, or the
 upright face a sash or sliding door slides across.
 Must not fire: when a refiner already found the handle (``stacked_parts``), the part is not flat (or
@@ -39,10 +44,12 @@ class HandleConfig:
     """``min_standoff``..``max_standoff`` (m): how far out of the face handle points stand;
     ``margin`` (m): the face's in-plane extent is grown by it; ``vertical_hinge_min_z``: a hinge whose
     unit direction has at least this |z| counts as vertical (its handle is centred across the bar);
-    ``slide_margin`` (m): a sliding part's handle lies within its own extent grown by this."""
+    ``slide_margin`` (m): a sliding part's handle lies within its own extent grown by this;
+    ``far_standoff`` (m): the band's outer end for a second search when the first finds nothing."""
 
     min_standoff: float = 0.012
     max_standoff: float = 0.08
+    far_standoff: float = 0.13
     margin: float = 0.1
     vertical_hinge_min_z: float = 0.5
     slide_margin: float = 0.01
@@ -53,6 +60,7 @@ class HandleConfig:
         require(self.margin >= 0, "handle.margin must be >= 0 (metres)")
         require(0.0 <= self.vertical_hinge_min_z <= 1.0, "handle.vertical_hinge_min_z must be in [0, 1]")
         require(self.slide_margin >= 0, "handle.slide_margin must be >= 0 (metres)")
+        require(self.far_standoff >= 0, "handle.far_standoff must be >= 0 (metres; 0: no second search)")
 
 
 class Handle:
@@ -68,10 +76,25 @@ class Handle:
         if face is None:
             return False
         c = self.config
+        handles = self.handles(draft, face, c.max_standoff)
+        if not handles and c.far_standoff > c.max_standoff:
+            # nothing in the usual band: a bar on long posts, or a face fitted to a recessed panel
+            # behind the part's front, stands farther out
+            handles = self.handles(draft, face, c.far_standoff)
+        if not handles:
+            return False
+        draft.grasp, draft.from_handle = handles[0].point, True
+        draft.other_handles = [g.point for g in handles[1:] if twin(g, handles[0])]
+        return True
+
+    def handles(self, draft: Draft, face: PartPlane, max_standoff: float) -> list[GraspCandidate]:
+        """The bar and knob candidates standing ``min_standoff``..``max_standoff`` m off ``face``, best
+        first; a sliding part's only within its own extent."""
+        c = self.config
         across = draft.joint_type == "prismatic" or abs(float(draft.direction[2])) >= c.vertical_hinge_min_z
         found = find_grasp_candidates(
             draft.handle_cloud, draft.panel, plane=face, centre_across=across,
-            config=GraspCandidateConfig(min_standoff=c.min_standoff, max_standoff=c.max_standoff,
+            config=GraspCandidateConfig(min_standoff=c.min_standoff, max_standoff=max_standoff,
                                         margin=c.margin, min_points=draft.handle_min_points))
         handles = [g for g in found if g.kind in ("bar", "knob")]
         if draft.joint_type == "prismatic":
@@ -79,11 +102,7 @@ class Handle:
             # would run into the frame or track it slides in (a bar beside a sash is the frame's, or a
             # plinth's). A hinged part's handle may overhang its free edge (a lever), swinging clear
             handles = [g for g in handles if over_part(g.point, draft.panel, face, c.slide_margin)]
-        if not handles:
-            return False
-        draft.grasp, draft.from_handle = handles[0].point, True
-        draft.other_handles = [g.point for g in handles[1:] if twin(g, handles[0])]
-        return True
+        return handles
 
 
 TWIN_BAR_ANGLE = np.radians(20.0)
