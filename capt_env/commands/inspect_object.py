@@ -89,6 +89,24 @@ def _picture(path: Path, env: Any, axis: np.ndarray, pivot: np.ndarray, grasp: n
     return path
 
 
+def handle_search_note(standoff: float) -> str:
+    """What CAPT's handle search (the ``handle`` refiner's default bands) makes of a grip standing
+    ``standoff`` m off its part's face: "" within the first band, else a note to print after it."""
+    from capt_env.wrappers.refiners.handle import HandleConfig
+
+    band = HandleConfig()
+    far = max(band.max_standoff, band.far_standoff)
+    if standoff > far:
+        return (f": beyond the band CAPT's handle search looks in ({100 * band.min_standoff:.1f}-"
+                f"{100 * far:.0f} cm off the face): with CAPT the grasp may fall back "
+                "to another piece or the part's edge")
+    if standoff > band.max_standoff:
+        return (f": beyond CAPT's first handle search ({100 * band.min_standoff:.1f}-"
+                f"{100 * band.max_standoff:.0f} cm off the face), found only when nothing stands "
+                f"in that band (the second looks out to {100 * far:.0f} cm)")
+    return ""
+
+
 def run(args: argparse.Namespace) -> int:
     import gymnasium as gym
     import torch
@@ -167,19 +185,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"grasp target ({obj.grasp_source}): {np.round(grasp_closed, 3).tolist()} m world")
     standoff = report["grasp_standoff_m"]
     if standoff is not None and obj.grasp_source != "edge":
-        from capt_env.wrappers.refiners.handle import HandleConfig
-
-        band = HandleConfig()
-        note = ""
-        far = max(band.max_standoff, band.far_standoff)
-        if standoff > far:
-            note = (f": beyond the band CAPT's handle search looks in ({100 * band.min_standoff:.1f}-"
-                    f"{100 * far:.0f} cm off the face): with CAPT the grasp may fall back "
-                    "to another piece or the part's edge")
-        elif standoff > band.max_standoff:
-            note = (f": beyond CAPT's first handle search ({100 * band.min_standoff:.1f}-"
-                    f"{100 * band.max_standoff:.0f} cm off the face), found only when nothing stands "
-                    f"in that band (the second looks out to {100 * far:.0f} cm)")
+        note = handle_search_note(standoff)
         print(f"handle: its grip stands {100 * standoff:.1f} cm off the part's face{note}")
     verdict = "in reach" if reach["ok"] else "OUT OF REACH: move it (object_xy) or scale it"
     print(f"reach from the Panda's shoulder: closed {reach['closed_m']:.2f} m, opened to "

@@ -101,3 +101,11 @@ def test_a_file_without_like_gets_the_model_of_how_its_part_moves(category: str,
     path = tmp_path / f"{category}.urdf"
     path.write_text(spec_to_urdf(make_object(category, iid)))
     assert ObjectTarget(label="file", task={"object": str(path)}).model_category() == expected
+
+
+def test_inspect_object_says_which_handle_search_finds_a_grip() -> None:
+    from capt_env.commands.inspect_object import handle_search_note
+
+    assert handle_search_note(0.05) == ""  # within the first band
+    assert "found only when nothing stands in that band" in handle_search_note(0.10)  # a bar on long posts
+    assert "may fall back" in handle_search_note(0.15)  # beyond both
