@@ -45,7 +45,8 @@ class HandleConfig:
     ``margin`` (m): the face's in-plane extent is grown by it; ``vertical_hinge_min_z``: a hinge whose
     unit direction has at least this |z| counts as vertical (its handle is centred across the bar);
     ``slide_margin`` (m): a sliding part's handle lies within its own extent grown by this;
-    ``far_standoff`` (m): the band's outer end for a second search when the first finds nothing."""
+    ``far_standoff`` (m): the band's outer end for a second search when the first finds nothing
+    (at most ``max_standoff``: no second search)."""
 
     min_standoff: float = 0.012
     max_standoff: float = 0.08
@@ -60,7 +61,8 @@ class HandleConfig:
         require(self.margin >= 0, "handle.margin must be >= 0 (metres)")
         require(0.0 <= self.vertical_hinge_min_z <= 1.0, "handle.vertical_hinge_min_z must be in [0, 1]")
         require(self.slide_margin >= 0, "handle.slide_margin must be >= 0 (metres)")
-        require(self.far_standoff >= 0, "handle.far_standoff must be >= 0 (metres; 0: no second search)")
+        require(self.far_standoff >= 0,
+                "handle.far_standoff must be >= 0 (metres; at most max_standoff: no second search)")
 
 
 class Handle:
