@@ -11,8 +11,9 @@ surface by area. Order of preference:
 4. No handle: the middle of the free edge of the outer face (a hinged part), or the middle of the
    outer face (a sliding part), where a hand can hook or pinch.
 
-For a named or found handle the target is the centre of its outermost layer (``GRIP_DEPTH`` deep
-along the outward normal), the bar a hand closes on rather than the posts that hold it.
+For a named or found handle the target is the middle of its outermost layer (``GRIP_DEPTH`` deep
+along the outward normal: the bar a hand closes on rather than the posts that hold it), half the
+bar's thickness behind its front (:func:`_grip_centre`).
 """
 
 from __future__ import annotations
@@ -119,8 +120,28 @@ def face_level(heights: np.ndarray) -> float:
 
 
 def _grip_centre(points: np.ndarray, outward: np.ndarray) -> np.ndarray:
+    """The point (3,) a closing hand centres on, of a handle's surface points (N, 3), link frame.
+
+    Across the face: the middle of the handle's outermost layer (``GRIP_DEPTH`` deep), the bar a
+    hand closes on rather than the posts that hold it. Along the unit ``outward`` normal: half the
+    handle's thickness behind its front, so that the fingers close round the bar's middle. A bar or
+    knob is about as deep as it is wide, and its outermost layer spans about its width across its
+    narrower direction in the face's plane; the layer's own mean depth (under a centimetre) is the
+    middle of a thin bar but the front of a thick one (a 4.6 cm lever closed on there squeezes out
+    of the fingers). Never deeper than the handle's points reach."""
     h = points @ outward
-    return points[h >= h.max() - GRIP_DEPTH].mean(axis=0)
+    front = float(h.max())
+    layer = points[h >= front - GRIP_DEPTH]
+    centre = layer.mean(axis=0)
+    flat = layer - np.outer(layer @ outward, outward)
+    flat = flat - flat.mean(axis=0)
+    _, vecs = np.linalg.eigh(flat.T @ flat)  # ascending; outward itself has no spread in `flat`
+    in_plane = [v for v in vecs.T if abs(float(v @ outward)) < 0.5]
+    narrow = in_plane[0] if in_plane else vecs[:, 0]
+    across = flat @ narrow
+    width = float(np.percentile(across, 98) - np.percentile(across, 2)) if len(across) > 1 else 0.0
+    depth = min(max(0.5 * width, front - float(centre @ outward)), front - float(h.min()))
+    return centre - (float(centre @ outward) - (front - depth)) * outward
 
 
 def _proudest_piece(points: np.ndarray, outward: np.ndarray) -> np.ndarray:

@@ -57,7 +57,33 @@ def test_a_thick_bar_at_the_end_of_a_wide_door_is_grasped_not_the_panel_end_its_
 def test_knob_is_found() -> None:
     meshes = [door_panel(), box("m1", (-0.02, 0.36, 0.3), (0.025, 0.025, 0.025))]
     target = find(meshes)
-    assert np.linalg.norm(target.point[1:] - [0.36, 0.3]) < 0.01 and target.point[0] < -0.02
+    # in the knob (x from -0.0325 to -0.0075), about its middle: the fingers close round it
+    assert np.linalg.norm(target.point[1:] - [0.36, 0.3]) < 0.01 and -0.026 < target.point[0] < -0.014
+
+
+def test_a_thick_round_bar_is_grasped_at_its_middle_not_its_front() -> None:
+    # Meta-World's lever door: a round bar 4.6 cm thick, 12 cm out on a stem. Centred on the bar's
+    # outermost 1.5 cm, the fingers close 1.6 cm in front of its axis and squeeze it out; the grip
+    # is half the bar's thickness behind its front, on the axis.
+    bar = trimesh.creation.cylinder(radius=0.023, height=0.15, sections=48)
+    bar.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [1.0, 0.0, 0.0]))
+    bar.apply_translation((-0.12, 0.3, 0.25))
+    meshes = [door_panel(), ShapeMesh("bar", np.asarray(bar.vertices), np.asarray(bar.faces)),
+              box("stem", (-0.05, 0.3, 0.25), (0.1, 0.026, 0.026))]
+    target = find(meshes)
+    assert target.source == "geometry"
+    # the bar tilts the panel's fitted normal 3 deg along the bar, which moves the grip along it
+    assert abs(target.point[0] + 0.12) < 0.008 and abs(target.point[2] - 0.25) < 0.005
+    assert abs(target.point[1] - 0.3) < 0.02
+
+
+def test_a_thin_bar_is_grasped_at_its_middle_too() -> None:
+    # a 1 cm bar lies wholly inside the outermost layer: its middle is the layer's own middle
+    meshes = [door_panel(), box("bar", (-0.045, 0.35, 0.25), (0.01, 0.01, 0.16)),
+              box("post1", (-0.02, 0.35, 0.19), (0.04, 0.01, 0.01)),
+              box("post2", (-0.02, 0.35, 0.31), (0.04, 0.01, 0.01))]
+    target = find(meshes)
+    assert np.linalg.norm(target.point - [-0.045, 0.35, 0.25]) < 0.004
 
 
 def test_lever_standing_12cm_off_the_panel_is_found() -> None:
