@@ -226,11 +226,17 @@ class RevolutePullConfig:
     """A hinged part (not a lid nor a door that falls open) whose pull stalls past this angle (rad), the
     fingers holding and no wrist joint at its limit, is at its end stop and is not grasped again (0:
     off): reaching for its handle again knocks it back towards closed."""
+    open_above: float = 1.5
+    """Such a part whose pull stalls past this angle (rad) by the hand's measure and as seen is open
+    and is not grasped again even with a wrist joint at its limit (0: off): the hand, stopped beside
+    a door swung round a quarter turn, turns round beside it for the other finger order and knocks it
+    back, and a quarter turn is more than three quarters of a side door's range up to 120 deg."""
 
     def validate(self) -> None:
         _positive(self, "lead", "target", "stall_progress", where="pull.revolute.")
         _share(self, "wrist_follow", where="pull.revolute.")
         _non_negative(self, "stop_above", where="pull.revolute.", note=" rad (0: off)")
+        _non_negative(self, "open_above", where="pull.revolute.", note=" rad (0: off)")
 
 
 @dataclass(frozen=True)

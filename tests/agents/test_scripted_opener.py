@@ -603,10 +603,10 @@ def _side_door_pull_begun(cfg: ScriptedOpenerConfig) -> tuple[ScriptedOpener, Jo
 
 
 def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: float,
-                          seen: float | None = None) -> ScriptedOpener:
+                          seen: float | None = None, arm_qpos: np.ndarray | None = None) -> ScriptedOpener:
     """An opener that grasped a closed door on a vertical hinge (:func:`_side_door_pull_begun`) and
-    whose hand, fingers ``finger_gap`` m apart, stopped ``state`` rad round the hinge, the door seen
-    ``seen`` rad open (``state`` when None)."""
+    whose hand, fingers ``finger_gap`` m apart, the arm at ``arm_qpos``, stopped ``state`` rad round
+    the hinge, the door seen ``seen`` rad open (``state`` when None)."""
     opener, closed, rot = _side_door_pull_begun(cfg)
     u, pivot = closed.direction, closed.pivot
     turn = axis_angle_matrix(u, state)
@@ -614,7 +614,7 @@ def _side_door_stalled_at(state: float, cfg: ScriptedOpenerConfig, finger_gap: f
                             pivot + turn @ (closed.grasp_point - pivot))
     at = _pose(turn @ rot, est.grasp_point)
     for _ in range(cfg.pull.stall_steps + 2):
-        opener.act_on(est, at, finger_gap=finger_gap)
+        opener.act_on(est, at, finger_gap=finger_gap, arm_qpos=arm_qpos)
         if opener.phase != Phase.PULL:
             break
     assert opener.phase == Phase.RELEASE
@@ -632,6 +632,22 @@ def test_a_side_door_held_far_open_that_stalls_is_at_its_stop() -> None:
                           (far, _cfg(pull__revolute__stop_above=0.0))):
         opener = _side_door_stalled_at(state, config, finger_gap=0.02)
         assert opener.ctx.grasp_again and opener.regrasps == 1, state
+
+
+def test_a_side_door_held_past_a_quarter_turn_when_the_wrist_runs_out_is_left_open() -> None:
+    # the arm stopped with wrist joint 7 at its limit, not the door at its stop: short of
+    # open_above that grasps again with the fingers the other way round; past it, by the hand's
+    # measure and as seen, the door is open and the hand turning round beside it would knock it back
+    cfg = ScriptedOpenerConfig()
+    past = cfg.pull.revolute.open_above + 0.05
+    assert cfg.pull.revolute.stop_above < past < cfg.pull.revolute.target
+    opener = _side_door_stalled_at(past, cfg, finger_gap=0.02, arm_qpos=WRIST_AT_LIMIT)
+    assert not opener.ctx.grasp_again and opener.regrasps == 0
+    for state, seen, config in ((past - 0.1, None, cfg),  # between stop_above and open_above
+                                (past, past - 0.1, cfg),  # seen short of it
+                                (past, None, _cfg(pull__revolute__open_above=0.0))):
+        opener = _side_door_stalled_at(state, config, finger_gap=0.02, seen=seen, arm_qpos=WRIST_AT_LIMIT)
+        assert opener.ctx.grasp_again and opener.regrasps == 1 and opener.ctx.grasp.other_fingers, state
 
 
 def test_a_side_door_at_its_stop_whose_handle_slid_out_of_the_fingers_is_left_open() -> None:
@@ -738,6 +754,7 @@ def test_bad_opener_config_is_rejected() -> None:
                        ({"recovery": {"wrist_limit_margin": -0.1}}, "recovery.wrist_limit_margin"),
                        ({"falling_door": {"done_above": -1.0}}, "falling_door.done_above"),
                        ({"pull": {"revolute": {"stop_above": -0.5}}}, "pull.revolute.stop_above"),
+                       ({"pull": {"revolute": {"open_above": -0.5}}}, "pull.revolute.open_above"),
                        ({"pull": {"prismatic": {"stop_above": -0.1}}}, "pull.prismatic.stop_above"),
                        ({"falling_door": {"window": 0}}, "falling_door.window"),
                        ({"approach": {"rechoose_grasp_m": -0.01}}, "approach.rechoose_grasp_m")):

@@ -117,14 +117,16 @@ class Pull(OpenerPhase):
                 # hand and the perception must say so: fingers slipping along the handle carry the
                 # hand round the arc ahead of the door
                 ctx.grasp_again = False
-            stop_above = cfg.pull.revolute.stop_above
+            stop_above, open_above = cfg.pull.revolute.stop_above, cfg.pull.revolute.open_above
+            end_stop = (0.0 < stop_above <= state
+                        and (not wrist_stuck if holding else stop_above <= float(est.state)))
             if (stalled and revolute and grip.stall_can_be_end_stop and not falls
-                    and 0.0 < stop_above <= state
-                    and (not wrist_stuck if holding else stop_above <= float(est.state))):
+                    and (end_stop or 0.0 < open_above <= min(state, float(est.state)))):
                 # far open: the part is at its end stop, and reaching for the handle again would knock
                 # it back. Held, the hand's measure says so unless a wrist joint at its limit stopped
                 # the arm; let go, the hand carried on along the arc past the stopped part and slid
-                # off its handle (pinning the wrist as it went), so the part as seen must say so too
+                # off its handle (pinning the wrist as it went), so the part as seen must say so too.
+                # Past a quarter turn, by both measures, the part is open whatever stopped the arm
                 ctx.grasp_again = False
             ctx.regrasps += int(ctx.grasp_again)
             ctx.let_go_state = state
