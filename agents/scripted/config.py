@@ -229,8 +229,10 @@ class RevolutePullConfig:
     open_above: float = 1.5
     """Such a part whose pull stalls past this angle (rad) by the hand's measure and as seen is open
     and is not grasped again even with a wrist joint at its limit (0: off): the hand, stopped beside
-    a door swung round a quarter turn, turns round beside it for the other finger order and knocks it
-    back, and a quarter turn is more than three quarters of a side door's range up to 120 deg."""
+    a door swung round about a quarter turn, turns round beside it for the other finger order and
+    knocks it back, and 1.5 rad is three quarters of a side door's range up to 2.0 rad (115 deg). A
+    door of a wider range stalled there is left short of three quarters (a 120 deg microwave door at
+    0.72-0.74); the stall's two measures, each a few degrees off, cannot tell the two apart."""
 
     def validate(self) -> None:
         _positive(self, "lead", "target", "stall_progress", where="pull.revolute.")
@@ -401,6 +403,14 @@ class SideDoorConfig:
     (the roll would turn the bar into its palm). On the Panda's kinematics, a handle 37 cm from the
     hinge is followed to 1.5 rad at 0.8 and falls short near 1.45 rad turning fully
     (``tests/agents/test_side_door_reach.py``)."""
+    pry_gap: float = 0.004
+    """A held upright bar that widens the finger gap by more than this (m) over the pull's first held
+    gap is turning between the pads and prying them apart (a flat bar turned on its edge); from then
+    on in that pull the hand turns by ``pry_follow`` of the door's angle instead (0: off)."""
+    pry_follow: float = 0.6
+    """The share of the door's angle a hand across an upright bar that pries its fingers apart turns
+    by: held on, the bar levers out of the fingers within a few steps and the hand runs on round the
+    arc without the door."""
     pull_roll_from: float = 1.0
     """The roll starts once the door has turned this far (rad): nearer closed the arm has reach to
     spare, and a hand square to the door holds its handle best (each turn of the hand moves the pads on
@@ -415,6 +425,9 @@ class SideDoorConfig:
                 f"side_door.upright_bar_follow must be in [0, 1], got {self.upright_bar_follow}")
         require(self.pull_roll_from >= 0.0,
                 f"side_door.pull_roll_from must be >= 0 rad, got {self.pull_roll_from}")
+        require(self.pry_gap >= 0.0, f"side_door.pry_gap must be >= 0 m (0: off), got {self.pry_gap}")
+        require(0.0 <= self.pry_follow <= 1.0,
+                f"side_door.pry_follow must be in [0, 1], got {self.pry_follow}")
 
 
 @dataclass(frozen=True)

@@ -149,24 +149,28 @@ class PartStrategy(ABC):
         door reaches the Panda's wrist limit)."""
         return self.cfg.pull.revolute.wrist_follow
 
-    def hand_turn(self, est: JointAxisEstimate, lifting: bool, grasp_r: np.ndarray) -> float:
+    def hand_turn(self, est: JointAxisEstimate, lifting: bool, grasp_r: np.ndarray,
+                  prying: bool = False) -> float:
         """The share of the part's angle the hand turns by while pulling about ``est``'s hinge, for a
         grasp with TCP rotation ``grasp_r`` (3, 3). About a hinge ``est`` shows vertical (a side
         door's: the wrist has room): fully for a hand closed across a level bar (a lever stays square
         in the fingers), ``side_door.upright_bar_follow`` for one closing level, across an upright bar
-        (:func:`closes_across_level_bar`); else :meth:`wrist_follow`. Read from the look at hand, not
-        from the kind of the grasp: the hinge seen while pulling is the one the hand follows."""
+        (:func:`closes_across_level_bar`), or ``side_door.pry_follow`` once that bar has pried the
+        fingers apart (``prying``); else :meth:`wrist_follow`. Read from the look at hand, not from
+        the kind of the grasp: the hinge seen while pulling is the one the hand follows."""
         if not is_vertical_hinge(est, self.cfg):
             return self.wrist_follow(lifting)
-        return FULL_TURN if closes_across_level_bar(grasp_r) else self.cfg.side_door.upright_bar_follow
+        if closes_across_level_bar(grasp_r):
+            return FULL_TURN
+        return self.cfg.side_door.pry_follow if prying else self.cfg.side_door.upright_bar_follow
 
     def pulling_rotation(self, est: JointAxisEstimate, lifting: bool, grasp_r: np.ndarray, u: np.ndarray,
-                         delta: float, turned: float) -> np.ndarray:
+                         delta: float, turned: float, prying: bool = False) -> np.ndarray:
         """The pulling hand's rotation (3, 3) about a hinge along unit ``u`` (3,): the grasp rotation
         ``grasp_r`` (3, 3) turned by :meth:`hand_turn`'s share of ``delta`` (rad along the arc the hand
-        is sent to), then :meth:`pull_rotation` for the part turned ``turned`` rad since the grasp.
-        The pull and the finger-order rehearsal both ask this."""
-        follow = self.hand_turn(est, lifting, grasp_r)
+        is sent to; ``prying``: see there), then :meth:`pull_rotation` for the part turned ``turned``
+        rad since the grasp. The pull and the finger-order rehearsal both ask this."""
+        follow = self.hand_turn(est, lifting, grasp_r, prying)
         return self.pull_rotation(axis_angle_matrix(u, follow * delta) @ grasp_r, turned)
 
     def inward(self, lifting: bool) -> float:

@@ -144,6 +144,10 @@ def test_a_side_door_is_pitched_further_and_the_hand_turns_with_it() -> None:
     lever = quarter_turn(rot, rot)
     assert door.hand_turn(_side_door(), lifting=False, grasp_r=lever) == 1.0
     assert door.hand_turn(_side_door(), lifting=False, grasp_r=rot) == CFG.side_door.upright_bar_follow < 1.0
+    # and lags it further once the upright bar has pried the fingers apart; a lever's hand does not
+    assert (door.hand_turn(_side_door(), lifting=False, grasp_r=rot, prying=True)
+            == CFG.side_door.pry_follow < CFG.side_door.upright_bar_follow)
+    assert door.hand_turn(_side_door(), lifting=False, grasp_r=lever, prying=True) == 1.0
     # the hinge the look shows decides: a door grasped as a side door, seen tilted, turns by the share
     assert door.hand_turn(_oven(), lifting=False, grasp_r=rot) == CFG.pull.revolute.wrist_follow
     assert door.pull_target(revolute=True) == CFG.pull.revolute.target and door.stall_can_be_end_stop

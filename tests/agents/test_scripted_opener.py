@@ -634,6 +634,28 @@ def test_a_side_door_held_far_open_that_stalls_is_at_its_stop() -> None:
         assert opener.ctx.grasp_again and opener.regrasps == 1, state
 
 
+def test_an_upright_bar_prying_the_fingers_apart_is_noted_for_the_rest_of_the_pull() -> None:
+    # a flat bar turning between the pads pushes them apart before it levers out: once the gap is
+    # more than pry_gap wider than at the first held step, the hand lags the door by pry_follow
+    cfg = ScriptedOpenerConfig()
+    opener, closed, rot = _side_door_pull_begun(cfg)
+    at = _pose(rot, closed.grasp_point)
+    base = 0.028
+    for gap in (base, base + 0.5 * cfg.side_door.pry_gap, base - 0.002):  # steady, or narrower
+        opener.act_on(closed, at, finger_gap=gap)
+        assert opener.phase == Phase.PULL and not opener.ctx.pull.prying, gap
+    opener.act_on(closed, at, finger_gap=base + 1.5 * cfg.side_door.pry_gap)
+    assert opener.ctx.pull.prying
+    opener.act_on(closed, at, finger_gap=base)  # latched for the pull
+    assert opener.ctx.pull.prying
+    off = ScriptedOpener(_cfg(side_door__pry_gap=0.0))
+    off.act_on(closed, at)
+    off.enter(start_pull(off.ctx, closed.grasp_point, rot, closed, "closed"))
+    for gap in (base, base + 0.02):
+        off.act_on(closed, at, finger_gap=gap)
+    assert not off.ctx.pull.prying
+
+
 def test_a_side_door_held_past_a_quarter_turn_when_the_wrist_runs_out_is_left_open() -> None:
     # the arm stopped with wrist joint 7 at its limit, not the door at its stop: short of
     # open_above that grasps again with the fingers the other way round; past it, by the hand's
@@ -755,6 +777,7 @@ def test_bad_opener_config_is_rejected() -> None:
                        ({"falling_door": {"done_above": -1.0}}, "falling_door.done_above"),
                        ({"pull": {"revolute": {"stop_above": -0.5}}}, "pull.revolute.stop_above"),
                        ({"pull": {"revolute": {"open_above": -0.5}}}, "pull.revolute.open_above"),
+                       ({"side_door": {"pry_follow": 1.5}}, "side_door.pry_follow"),
                        ({"pull": {"prismatic": {"stop_above": -0.1}}}, "pull.prismatic.stop_above"),
                        ({"falling_door": {"window": 0}}, "falling_door.window"),
                        ({"approach": {"rechoose_grasp_m": -0.01}}, "approach.rechoose_grasp_m")):

@@ -92,6 +92,10 @@ class PullTrack:
     """The gap jumped (``pull.prismatic.track_fit_max_gap_change``): the hand's path no longer counts."""
     slip_count: int = 0
     """Steps running the hand has been off the grasp point with its fingers closed on nothing."""
+    first_gap: float | None = None
+    """The finger gap (m) at the first step of this pull the fingers held the part."""
+    prying: bool = False
+    """A held bar has widened the finger gap by more than ``side_door.pry_gap`` this pull."""
     step_share: float = 1.0
     """The share of the commanded steps the pull moves by (``pull.step_shrink``)."""
     last_q: np.ndarray | None = None

@@ -48,6 +48,7 @@ def start_pull(ctx: OpenerContext, p: np.ndarray, r: np.ndarray, est: JointAxisE
     track.hinge_fit = None
     track.line_fit, track.line_gap, track.line_slipped = None, None, False
     track.slip_count = 0
+    track.first_gap, track.prying = None, False
     track.step_share, track.last_q = 1.0, None
     # a hand lifting from below holds with closed fingers; unknown gaps count as holding
     return Pull(why, grip="held" if ctx.lift else "none")
@@ -105,6 +106,7 @@ class Pull(OpenerPhase):
             stalled = progress < min_progress
         holding = finger_gap is not None and finger_gap >= cfg.grasp.hold_gap
         record_grip(ctx, holding, finger_gap is None)
+        note_prying(ctx, finger_gap if holding else None)
         falls = release.lets_fall(ctx)
         fall = cfg.falling_door
         if state >= target or stalled or at_limit:
@@ -230,7 +232,19 @@ def pull_pose(ctx: OpenerContext, grip: PartStrategy, est: JointAxisEstimate, u:
         # they are: the estimated arc alone runs off the face as the lid turns
         p_des = pressed(p_des, p, pivot, u, press)
     turned = state - track.grasp_state
-    return p_des, grip.pulling_rotation(est, ctx.lift, track.grasp_r, u, delta, turned)
+    return p_des, grip.pulling_rotation(est, ctx.lift, track.grasp_r, u, delta, turned, track.prying)
+
+
+def note_prying(ctx: OpenerContext, held_gap: float | None) -> None:
+    """Latch ``ctx.pull.prying`` once the gap of the fingers holding the part (``held_gap`` m; None:
+    not holding) is more than ``side_door.pry_gap`` wider than at the first held step of this pull:
+    a bar turning between the pads pushes them apart before it levers out of them."""
+    track, limit = ctx.pull, ctx.cfg.side_door.pry_gap
+    if held_gap is None or limit <= 0.0:
+        return
+    if track.first_gap is None:
+        track.first_gap = held_gap
+    track.prying = track.prying or held_gap - track.first_gap > limit
 
 
 def pressed(p_des: np.ndarray, p: np.ndarray, pivot: np.ndarray, u: np.ndarray, press: float) -> np.ndarray:
