@@ -6,7 +6,10 @@ opener beside it, exactly as in training (agents.ppo.residual).
 
 from __future__ import annotations
 
+import contextlib
 import pickle
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +28,15 @@ CONSTANT_FEATURE_VAR = 1e-6
 """Training variance under which an observation feature counts as constant (see :class:`PPOPolicy`):
 the running statistics leave ~1e-9 (their prior, variance 1 at count 1e-4) on a feature that never
 changed; the least-varying real feature of the shipped policies has ~4e-5."""
+
+
+@contextlib.contextmanager
+def _numpy1_pickles() -> Iterator[None]:
+    """Unpickle files written under numpy 1 without numpy 2's warning that they name ``numpy.core``
+    (the shipped policies are saved under numpy 1.26 so that numpy 1 and 2 both load them)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=r"numpy\.core", category=DeprecationWarning)
+        yield
 
 
 def run_config_of(model_path: str | Path) -> dict[str, Any] | None:
@@ -87,14 +99,15 @@ class PPOPolicy:
         norm_path = Path(vecnormalize) if vecnormalize is not None else vecnormalize_path(path)
         obs_norm = None
         if norm_path.is_file():
-            with norm_path.open("rb") as fh:
+            with norm_path.open("rb") as fh, _numpy1_pickles():
                 obs_norm = pickle.load(fh)  # noqa: S301 - SB3's own format; trusted files only
             if not isinstance(obs_norm, VecNormalize):
                 raise ValueError(f"{norm_path} holds a {type(obs_norm).__name__}, "
                                  "not VecNormalize statistics")
         elif vecnormalize is not None:
             raise FileNotFoundError(f"no VecNormalize statistics at {norm_path}")
-        model = PPO.load(path, device=device)
+        with _numpy1_pickles():
+            model = PPO.load(path, device=device)
         residual = None
         run_config = run_config_of(path) or {}
         residual_cfg = run_config.get("residual") or {}

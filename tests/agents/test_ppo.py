@@ -178,3 +178,38 @@ def test_training_episodes_continue_after_success_only() -> None:
     assert ContinueAfterSuccess(_EndsEpisode(success=True)).step(np.zeros(1))[2] is False
     assert ContinueAfterSuccess(_EndsEpisode(success=False)).step(np.zeros(1))[2] is True
     assert tiny().continue_after_success and not tiny(continue_after_success=False).continue_after_success
+
+
+def _pickled_modules(blob: bytes) -> set[str]:
+    """The modules a pickle imports (its GLOBAL / STACK_GLOBAL opcodes' module names)."""
+    import pickletools
+
+    modules, strings = set(), []
+    for op, arg, _ in pickletools.genops(blob):
+        if op.name in ("SHORT_BINUNICODE", "BINUNICODE", "UNICODE"):
+            strings.append(arg)
+        elif op.name == "GLOBAL":
+            modules.add(str(arg).split(" ")[0])
+        elif op.name == "STACK_GLOBAL" and len(strings) >= 2:
+            modules.add(strings[-2])
+    return modules
+
+
+@pytest.mark.parametrize("category", sorted(SHIPPED_OPENERS))
+def test_shipped_policies_unpickle_under_numpy_1_and_2(category: str) -> None:
+    """The shipped policies' pickles (VecNormalize statistics, the SB3 zip's serialised objects) name
+    no module that only numpy 2 has (``numpy._core``): saved under numpy 1, both numpy 1 and 2 load
+    them, so an environment with numpy < 2 (mplib, ManiSkill's motion planner) runs them too."""
+    import base64
+    import json
+    import zipfile
+
+    folder = ROOT / "agents" / "ppo" / "policies" / category
+    blobs = [(folder / "vecnormalize.pkl").read_bytes()]
+    with zipfile.ZipFile(folder / "final.zip") as archive:
+        data = json.loads(archive.read("data"))
+    blobs += [base64.b64decode(item[":serialized:"]) for item in data.values()
+              if isinstance(item, dict) and ":serialized:" in item]
+    modules = set().union(*(_pickled_modules(b) for b in blobs))
+    assert any(m.startswith("numpy") for m in modules)  # the check sees numpy's objects at all
+    assert not [m for m in modules if m.startswith("numpy._core")], modules
