@@ -32,6 +32,21 @@ to the side (its sliding cabinet), where the Panda's wrist cannot turn with the
 part."""
 
 
+RESTING_ARM_FRONT_X: float = 0.06
+RESTING_ARM_BOTTOM_Z: float = 0.13
+RESTING_ARM_HALF_Y: float = 0.15
+"""World metres. The space the Panda's resting arm (ManiSkill's rest pose with its reset noise) takes
+in front of its base: links 5-7, the hand and the fingers reach x <= 0.059, z >= 0.132 and
+|y| <= 0.132 (measured over 60 resets with the links' collision meshes)."""
+RESTING_ARM_CLEARANCE: float = 0.02
+"""World metres. Every episode the object is moved along +x, if need be, so that the part of its
+closed bounding box at the resting arm's heights and sides starts at least this far in front of
+``RESTING_ARM_FRONT_X``: otherwise the arm starts against the object (the default placement left
+links 6-7 or the hand touching a deep oven's door on a quarter of the resets, a washing machine's
+on a sixth, and Franka Kitchen's cabinet handles under the fingers), holding a door that then falls
+open as it moves, or dragging the handle it rests on."""
+
+
 @dataclass(frozen=True)
 class CameraConfig:
     """One depth camera looking at the object.
@@ -82,11 +97,14 @@ class TaskConfig:
     ``object_xy`` +- ``object_xy_noise`` on the table top, its front facing the robot, turned by a
     yaw uniform in +-``yaw_noise``. The Panda's base is at (-0.615, 0) and its resting hand near
     x = 0. ``object_xy`` None (the default) means the category's placement
-    (:data:`CATEGORY_OBJECT_XY`, else :data:`DEFAULT_OBJECT_XY`): 0.3 m keeps deep objects (ovens,
-    cabinets) clear of the hand at reset; a laptop sits under the resting hand at -0.08 m, because
+    (:data:`CATEGORY_OBJECT_XY`, else :data:`DEFAULT_OBJECT_XY`): 0.3 m keeps most deep objects
+    (ovens, cabinets) clear of the hand at reset; a laptop sits under the resting hand at -0.08 m, because
     its lid's lip, swung up to vertical 0.2-0.3 m behind where it started, is beyond the Panda's
     reach from 0.3 m. A user file placed by default is then moved so that its closed grasp target
-    lies where the procedural ones do (:data:`USER_GRASP_X`, :data:`USER_GRASP_MAX_Y`).
+    lies where the procedural ones do (:data:`USER_GRASP_X`, :data:`USER_GRASP_MAX_Y`). Every
+    episode, after the noise and yaw, an object whose closed bounding box would reach the resting arm
+    is moved straight away from the robot until it clears it (:data:`RESTING_ARM_CLEARANCE`): the
+    arm never starts against the object.
 
     Joint states at reset: the target joint starts at a fraction of its range uniform in
     ``target_init_fraction``; other joints uniform in ``other_init_fraction`` of their ranges.

@@ -61,7 +61,14 @@ from mani_skill.utils.structs import Articulation, Pose
 from capt_common.typed_yaml import from_dict
 from capt_env.registration import GENERIC_ID
 from capt_env.rendering import translate_render_error
-from capt_env.tasks.config import TaskConfig, read_task_yaml
+from capt_env.tasks.config import (
+    RESTING_ARM_BOTTOM_Z,
+    RESTING_ARM_CLEARANCE,
+    RESTING_ARM_FRONT_X,
+    RESTING_ARM_HALF_Y,
+    TaskConfig,
+    read_task_yaml,
+)
 from capt_env.tasks.object_batch import ObjectBatch, load_objects
 from capt_env.tasks.object_loading import LoadedObject
 
@@ -79,6 +86,25 @@ class _Placement:
     root_p: torch.Tensor  # (b, 3) metres
     root_q: torch.Tensor  # (b, 4) wxyz
     centre: torch.Tensor  # (b, 3) object bounding-box centre, metres
+
+
+def clear_of_resting_arm(lo: np.ndarray, hi: np.ndarray, yaw: np.ndarray, root_p: np.ndarray) -> np.ndarray:
+    """How far (b,) metres along world +x each object must move so that its bounding box (``lo``,
+    ``hi`` (b, 3), object frame), turned by ``yaw`` (b,) rad about +z with its root at ``root_p``
+    (b, 3), clears the Panda's resting arm by :data:`~capt_env.tasks.config.RESTING_ARM_CLEARANCE`:
+    0 for a box wholly below the arm's lowest point or beside it, else the distance that puts the
+    box's near face that far in front of the arm's front (the robot is at -x, facing +x)."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    corners = np.stack([np.stack([np.where(m & 1, hi[:, 0], lo[:, 0]), np.where(m & 2, hi[:, 1], lo[:, 1])],
+                                 axis=-1) for m in range(4)], axis=1)  # (b, 4, 2) footprint
+    c, s = np.cos(yaw)[:, None], np.sin(yaw)[:, None]
+    x = c * corners[..., 0] - s * corners[..., 1] + root_p[:, 0:1]
+    y = s * corners[..., 0] + c * corners[..., 1] + root_p[:, 1:2]
+    top = hi[:, 2] + root_p[:, 2]
+    in_reach = (top > RESTING_ARM_BOTTOM_Z) & (y.min(axis=1) < RESTING_ARM_HALF_Y) & (
+        y.max(axis=1) > -RESTING_ARM_HALF_Y)
+    needed = RESTING_ARM_FRONT_X + RESTING_ARM_CLEARANCE - x.min(axis=1)
+    return np.where(in_reach, np.maximum(needed, 0.0), 0.0)
 
 
 def _yaw_quat(yaw: torch.Tensor) -> torch.Tensor:
@@ -248,7 +274,10 @@ class OpenArticulatedEnv(BaseEnv):
         rot_cy = s * centre_local[:, 0] + c * centre_local[:, 1]
         z = torch.as_tensor(-lo[:, 2] + 1e-3, dtype=torch.float32)
         root_p = torch.stack([target_xy[:, 0] - rot_cx, target_xy[:, 1] - rot_cy, z], dim=-1)
-        centre = torch.stack([target_xy[:, 0], target_xy[:, 1], z + centre_local[:, 2]], dim=-1)
+        away = torch.as_tensor(clear_of_resting_arm(lo, hi, yaw.cpu().numpy(), root_p.cpu().numpy()),
+                               dtype=torch.float32)
+        root_p[:, 0] += away
+        centre = torch.stack([target_xy[:, 0] + away, target_xy[:, 1], z + centre_local[:, 2]], dim=-1)
         return _Placement(root_p=root_p, root_q=_yaw_quat(yaw), centre=centre)
 
     def _aim_cameras(self, rows: np.ndarray, placement: _Placement, yaw: np.ndarray) -> None:

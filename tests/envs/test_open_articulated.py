@@ -263,6 +263,50 @@ def test_placement_defaults_per_category_and_task_overrides() -> None:
         env.close()
 
 
+def test_object_moved_clear_of_the_resting_arm() -> None:
+    """A box reaching the resting arm's space is moved straight away from the robot until its near face
+    is the clearance in front of the arm; a box below the arm's lowest point, beside it, or already
+    clear stays; a turned box is judged by its turned footprint."""
+    from capt_env.tasks.config import RESTING_ARM_CLEARANCE, RESTING_ARM_FRONT_X
+    from capt_env.tasks.open_articulated import clear_of_resting_arm
+
+    lo, hi = np.array([[-0.2, -0.3, 0.0]]), np.array([[0.2, 0.3, 0.6]])  # 40 x 60 x 60 cm
+    front = RESTING_ARM_FRONT_X + RESTING_ARM_CLEARANCE
+
+    def away(root_x: float, root_y: float = 0.0, yaw: float = 0.0, top: float = 0.6) -> float:
+        box_hi = hi.copy()
+        box_hi[0, 2] = top
+        return float(clear_of_resting_arm(lo, box_hi, np.array([yaw]), np.array([[root_x, root_y, 0.0]]))[0])
+
+    assert away(0.2) == pytest.approx(front)  # near face at x = 0, against the hand
+    assert away(0.25) == pytest.approx(front - 0.05)
+    assert away(0.5) == 0.0  # already clear
+    assert away(0.2, top=0.1) == 0.0  # a laptop-low box under the hand
+    assert away(0.2, root_y=0.6) == 0.0  # beside the arm
+    assert away(0.3, yaw=np.pi / 2) == pytest.approx(front - 0.3 + 0.3)  # turned: 60 cm deep now
+
+
+@pytest.mark.parametrize(("category", "seeds"), [("oven", (400, 404, 405)), ("washing_machine", (418, 420))])
+def test_resting_arm_starts_clear_of_a_deep_object(category: str, seeds: tuple[int, ...]) -> None:
+    """No link of the resting arm presses on the object at reset: at the default placement these
+    resets of deep ovens and washing machines started with links 6-7 or the hand against the door."""
+    env = gym.make(env_id(category), obs_mode="state", task={"cameras": [CAMERA]})
+    try:
+        for seed in seeds:
+            env.reset(seed=seed)
+            env.step(np.zeros(env.action_space.shape, dtype=np.float32))
+            pressing = []
+            for contact in env.unwrapped.scene.get_contacts():
+                names = [body.entity.name for body in contact.bodies]
+                if ("panda" in names[0]) == ("panda" in names[1]):
+                    continue  # not robot-object
+                if any(np.linalg.norm(p.impulse) > 1e-4 or p.separation < 0.0 for p in contact.points):
+                    pressing.append(names)
+            assert not pressing, (seed, pressing)
+    finally:
+        env.close()
+
+
 def test_bad_inputs_give_clear_errors(tmp_path) -> None:
     with pytest.raises(ConfigError, match="unknown category"):
         gym.make(GENERIC_ID, task={"category": "toaster"})
