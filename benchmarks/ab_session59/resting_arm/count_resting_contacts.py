@@ -1,3 +1,8 @@
+"""Count resets whose first step has the resting arm pressing on the object (a robot-object contact
+with an impulse over 1e-4 N s or a penetration), two cameras, oracle, state observations.
+
+    python count_resting_contacts.py CATEGORY FIRST_SEED EPISODES
+"""
 import sys, numpy as np, gymnasium as gym
 from capt_env.env_factory import make_env
 import yaml, capt_env.shipped_configs as sc
