@@ -36,8 +36,8 @@ RESTING_ARM_FRONT_X: float = 0.06
 RESTING_ARM_BOTTOM_Z: float = 0.13
 RESTING_ARM_HALF_Y: float = 0.15
 """World metres. The space the Panda's resting arm (ManiSkill's rest pose with its reset noise) takes
-in front of its base: links 5-7, the hand and the fingers reach x <= 0.059, z >= 0.132 and
-|y| <= 0.132 (measured over 60 resets with the links' collision meshes)."""
+in front of its base: over 60 resets the collision meshes of links 5-7, the hand and the fingers
+reached x <= 0.059, z >= 0.132 and |y| <= 0.132 (|y| rounded up to 0.15: the noise is Gaussian)."""
 RESTING_ARM_CLEARANCE: float = 0.02
 """World metres. Every episode the object is moved along +x, if need be, so that the part of its
 closed bounding box at the resting arm's heights and sides starts at least this far in front of

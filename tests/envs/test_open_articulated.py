@@ -283,7 +283,7 @@ def test_object_moved_clear_of_the_resting_arm() -> None:
     assert away(0.5) == 0.0  # already clear
     assert away(0.2, top=0.1) == 0.0  # a laptop-low box under the hand
     assert away(0.2, root_y=0.6) == 0.0  # beside the arm
-    assert away(0.3, yaw=np.pi / 2) == pytest.approx(front - 0.3 + 0.3)  # turned: 60 cm deep now
+    assert away(0.3, yaw=np.pi / 2) == pytest.approx(front)  # turned, 60 cm deep: near face at x = 0
 
 
 @pytest.mark.parametrize(("category", "seeds"), [("oven", (400, 404, 405)), ("washing_machine", (418, 420))])
