@@ -7,15 +7,21 @@ pointcloud observations. MODE: ``off`` (the straight pre-grasp), ``cloud`` (plan
 isolated camera cloud), ``gt`` (planned round 20,000 points sampled on the object's collision meshes).
 Prints each seed's success, failure cause and the opener's plan checks, then the total.
 """
-import sys, yaml, json, numpy as np, trimesh
+import sys
+
+import numpy as np
+import trimesh
+import yaml
+from mani_skill.utils.geometry.trimesh_utils import get_component_mesh
+
+import capt_env.shipped_configs as sc
+from agents.scripted.config import ScriptedOpenerConfig
+from agents.scripted.opener import ScriptedOpener
+from agents.scripted.rollout import run_episode
+from capt_common.typed_yaml import from_dict
 from capt_env.env_factory import make_env
 from capt_env.wrappers.perception_wrapper import CaptObservationWrapper
-from agents.scripted.opener import ScriptedOpener
-from agents.scripted.config import ScriptedOpenerConfig
-from agents.scripted.rollout import run_episode
-from mani_skill.utils.geometry.trimesh_utils import get_component_mesh
-import capt_env.shipped_configs as sc
-from capt_common.typed_yaml import from_dict
+
 
 def gt_cloud(self, obs):
     art = self.env.unwrapped.articulation

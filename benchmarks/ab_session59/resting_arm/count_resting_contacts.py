@@ -3,25 +3,35 @@ with an impulse over 1e-4 N s or a penetration), two cameras, oracle, state obse
 
     python count_resting_contacts.py CATEGORY FIRST_SEED EPISODES
 """
-import sys, numpy as np, gymnasium as gym
+
+import sys
+
+import numpy as np
+import yaml
+
+import capt_env.shipped_configs as sc
 from capt_env.env_factory import make_env
-import yaml, capt_env.shipped_configs as sc
-cat = sys.argv[1]; first = int(sys.argv[2]); n = int(sys.argv[3])
-task = yaml.safe_load(open(sc.resolve_config("tasks", "two_cameras")))
-env = make_env(cat, {"source": "oracle"}, task=task, obs_mode="state")
-touch = []
-for s in range(first, first + n):
-    obs, info = env.reset(seed=s)
-    obs, *_ , info = env.step(np.zeros(7, dtype=np.float32))
-    scene = env.unwrapped.scene
-    cs = scene.get_contacts()
-    links = set()
-    for c in cs:
-        b0, b1 = c.bodies[0].entity.name, c.bodies[1].entity.name
-        imp = sum(float(np.linalg.norm(pt.impulse)) for pt in c.points)
-        sep = min((float(pt.separation) for pt in c.points), default=1.0)
-        if ("panda" in b0) != ("panda" in b1) and (imp > 1e-4 or sep < 0.0):
-            links.add(b0 if "panda" in b0 else b1)
-    if links:
-        touch.append((s, sorted(links)))
-print(cat, len(touch), "of", n, "resets with the arm touching the object:", [t[0] for t in touch])
+
+
+def main() -> None:
+    category, first, n = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+    task = yaml.safe_load(open(sc.resolve_config("tasks", "two_cameras")))
+    env = make_env(category, {"source": "oracle"}, task=task, obs_mode="state")
+    touching = []
+    for seed in range(first, first + n):
+        env.reset(seed=seed)
+        env.step(np.zeros(7, dtype=np.float32))
+        links = set()
+        for contact in env.unwrapped.scene.get_contacts():
+            b0, b1 = (body.entity.name for body in contact.bodies)
+            impulse = sum(float(np.linalg.norm(p.impulse)) for p in contact.points)
+            separation = min((float(p.separation) for p in contact.points), default=1.0)
+            if ("panda" in b0) != ("panda" in b1) and (impulse > 1e-4 or separation < 0.0):
+                links.add(b0 if "panda" in b0 else b1)
+        if links:
+            touching.append(seed)
+    print(category, len(touching), "of", n, "resets with the arm touching the object:", touching)
+
+
+if __name__ == "__main__":
+    main()
