@@ -43,7 +43,7 @@ RESTING_ARM_CLEARANCE: float = 0.02
 closed bounding box at the resting arm's heights and sides starts at least this far in front of
 ``RESTING_ARM_FRONT_X``: otherwise the arm starts against the object (the default placement left
 links 6-7 or the hand touching a deep oven's door on a quarter of the resets, a washing machine's
-on a sixth, and Franka Kitchen's cabinet handles under the fingers), holding a door that then falls
+on a sixth, and Franka Kitchen's cabinet handles against the hand), holding a door that then falls
 open as it moves, or dragging the handle it rests on."""
 
 
