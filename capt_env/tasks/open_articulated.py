@@ -264,7 +264,8 @@ class OpenArticulatedEnv(BaseEnv):
     def _placement(self, rows: np.ndarray, noise_xy: torch.Tensor, yaw: torch.Tensor) -> _Placement:
         """Root poses putting the bounding-box centre of the objects of sub-scenes ``rows`` (b,) at
         ``placement_xy()`` + the object's ``placement_shift`` + ``noise_xy`` (b, 2) on the table,
-        turned by ``yaw`` (b,) radians."""
+        turned by ``yaw`` (b,) radians, then moved along +x clear of the resting arm
+        (:func:`clear_of_resting_arm`)."""
         lo, hi = self.object_batch.aabb[rows, 0], self.object_batch.aabb[rows, 1]  # (b, 3) object frame
         centre_local = torch.as_tensor((lo + hi) / 2, dtype=torch.float32)
         shift = torch.as_tensor(self.object_batch.placement_shift[rows], dtype=torch.float32)
