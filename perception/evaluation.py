@@ -39,6 +39,7 @@ from perception.metrics import (
     mean_iou,
     segmentation_accuracy,
     state_error,
+    median_table_markdown,
     table_markdown,
 )
 from perception.normalisation import Normalisation
@@ -47,11 +48,13 @@ from perception.outlier_filter import OutlierFilter
 
 @dataclass(frozen=True)
 class EvaluationResult:
-    """Per-sample metrics of every checkpoint, median ms per input per method, and Table I in Markdown."""
+    """Per-sample metrics of every checkpoint, median ms per input per method, Table I in Markdown and
+    the median errors in Markdown (:func:`perception.metrics.median_table_markdown`)."""
 
     results: list[SampleResult]
     median_ms: dict[str, float]
     table: str
+    medians: str
 
 
 def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg: bool) -> SampleResult:
@@ -131,4 +134,4 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
             results.append(score_sample(pred, s, method, cfg.has_segmentation))
         times += [est.predict(clouds[i % len(clouds)]).latency_ms for i in range(timing_clouds - len(times))]
         median_ms[method] = statistics.median(times)
-    return EvaluationResult(results, median_ms, table_markdown(results))
+    return EvaluationResult(results, median_ms, table_markdown(results), median_table_markdown(results))

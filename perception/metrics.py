@@ -15,7 +15,9 @@ Conventions:
 - AP x = share of results with error strictly below x.
 - Beyond the paper, each summary also has the median direction error and the share of axes that
   point the other way (``dir_flipped``: error over 90 degrees): a few whole sign flips can carry a
-  mean error whose median is a fraction of a degree.
+  mean error whose median is a fraction of a degree; and the median axis-line distance in metres
+  (``pos_median_m``) and median state error (``state_median``, degrees or metres), shown with the
+  direction's in :func:`median_table_markdown`.
 """
 
 from __future__ import annotations
@@ -133,10 +135,15 @@ def _mean(xs: Sequence[float | None]) -> float:
     return float(np.mean(v)) if v else float("nan")
 
 
+def _median(xs: Sequence[float]) -> float:
+    return float(np.median(xs)) if len(xs) else float("nan")
+
+
 def summarise(results: Sequence[SampleResult]) -> dict[str, float | list[float]]:
     """Aggregate one (category, method) group: scalars for segmentation/time, per-joint lists otherwise
-    (the paper's columns, then ``dir_median`` in degrees and ``dir_flipped``, the share of direction
-    errors over :data:`FLIPPED_ABOVE_DEG`)."""
+    (the paper's columns, then ``dir_median`` in degrees, ``dir_flipped``, the share of direction
+    errors over :data:`FLIPPED_ABOVE_DEG`, ``pos_median_m`` in metres and ``state_median`` in
+    degrees or metres)."""
     out: dict[str, float | list[float]] = {
         "pa": _mean([r.pa for r in results]),
         "miou": _mean([r.miou for r in results]),
@@ -145,19 +152,20 @@ def summarise(results: Sequence[SampleResult]) -> dict[str, float | list[float]]
     }
     slots = sorted({j.joint_index for r in results for j in r.joints})
     keys = ["dir_med", "dir_ap5", "dir_ap10", "pos_aed", "pos_ap1", "pos_ap5", "state_med", "state_ap5",
-            "state_ap10", "dir_median", "dir_flipped"]
+            "state_ap10", "dir_median", "dir_flipped", "pos_median_m", "state_median"]
     cols: dict[str, list[float]] = {k: [] for k in keys}
     for k in slots:  # by joint slot (true joints fill the first slots, so this is their order)
         js = [j for r in results for j in r.joints if j.joint_index == k]
         d = [j.direction_error_deg for j in js]
         p = [j.position_error for j in js if j.position_error is not None]
+        p_m = [j.position_error_m for j in js if j.position_error_m is not None]
         s = [j.state_error for j in js]
         st = STATE_THRESHOLDS_DEG if js and js[0].joint_type == "revolute" else STATE_THRESHOLDS_M
         vals = [_mean(d), average_precision(d, DIR_THRESHOLDS_DEG[0]),
                 average_precision(d, DIR_THRESHOLDS_DEG[1]),
                 _mean(p), average_precision(p, POS_THRESHOLDS[0]), average_precision(p, POS_THRESHOLDS[1]),
                 _mean(s), average_precision(s, st[0]), average_precision(s, st[1]),
-                float(np.median(d)) if d else float("nan"), _share_above(d, FLIPPED_ABOVE_DEG)]
+                _median(d), _share_above(d, FLIPPED_ABOVE_DEG), _median(p_m), _median(s)]
         for key, v in zip(keys, vals, strict=True):
             cols[key].append(v)
     out.update(cols)
@@ -204,4 +212,27 @@ def table_markdown(results: Sequence[SampleResult]) -> str:
                 row.append(_fmt(_mean([float(v) for v in vals if not isinstance(v, list)]),
                                 1 if k == "time_ms" else 2))
             lines.append("| " + " | ".join(["Mean", m] + row) + " |")
+    return "\n".join(lines)
+
+
+MEDIAN_TABLE_COLUMNS = ("Dataset", "Method", "Dir median (deg)", "Flipped", "Pos median (cm)", "State median")
+
+
+def median_table_markdown(results: Sequence[SampleResult]) -> str:
+    """Median errors as Markdown, one row per (category, method): direction (degrees), the share of
+    flipped axes, axis-line distance (centimetres, '-' for prismatic joints) and state ('deg' for a
+    revolute joint, 'm' for a prismatic one). Multi-joint categories show one value per joint slot."""
+    groups: dict[tuple[str, str], list[SampleResult]] = {}
+    for r in results:
+        groups.setdefault((r.category, r.method), []).append(r)
+    lines = ["| " + " | ".join(MEDIAN_TABLE_COLUMNS) + " |", "|" + "---|" * len(MEDIAN_TABLE_COLUMNS)]
+    for (category, method), rs in groups.items():
+        s = summarise(rs)
+        slots = sorted({j.joint_index for r in rs for j in r.joints})
+        units = [next(j.joint_type for r in rs for j in r.joints if j.joint_index == k) for k in slots]
+        states = [f"{v:.1f} deg" if t == "revolute" else f"{v:.3f} m" for v, t in zip(s["state_median"], units,
+                                                                                        strict=True)]
+        pos = [100 * v for v in s["pos_median_m"]]
+        lines.append("| " + " | ".join([category, method, _fmt(s["dir_median"], 1), _fmt(s["dir_flipped"]),
+                                        _fmt(pos, 1), ", ".join(states) or "-"]) + " |")
     return "\n".join(lines)

@@ -81,7 +81,8 @@ def run(args: argparse.Namespace) -> int:
         noise += (f"Stray points filtered before the network: {outlier_filter.neighbours} neighbours, "
                   f"std ratio {outlier_filter.std_ratio:g}.\n\n")
     source = f"Perception source: `{PERCEPTION_SOURCE}` (the network alone, no refiners).\n\n"
-    text = (f"{source}{pose}{noise}{result.table}\n\nTime per input (median over >= {args.timing_clouds} "
+    text = (f"{source}{pose}{noise}{result.table}\n\nMedian errors (a few flipped axes can carry a mean; "
+            f"position: distance between the axis lines):\n\n{result.medians}\n\nTime per input (median over >= {args.timing_clouds} "
             f"clouds, device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")
     print(text)
     if args.markdown:
@@ -100,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
         "outlier_filter": None if outlier_filter is None else dataclasses.asdict(outlier_filter),
         "data": args.data, "checkpoints": args.checkpoints,
         "median_ms_per_input": result.median_ms, "summary": summary, "table_markdown": result.table,
+        "median_table_markdown": result.medians,
         "samples": [dataclasses.asdict(r) for r in result.results],
     })
     return 0

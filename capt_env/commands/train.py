@@ -14,8 +14,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="TrainConfig: a shipped name (capt, capt_plain, pct_regression, ...) or a YAML "
                              "path")
     parser.add_argument("--data", required=True, nargs="+",
-                        help="dataset directory made by `capt generate`; several (one per category) "
-                             "train one cross-category model (--config capt_cross_category)")
+                        help="dataset directory made by `capt generate`; several of one category (e.g. "
+                             "plain and varied clouds) train that category's model together, several "
+                             "categories one cross-category model (--config capt_cross_category)")
     parser.add_argument("--out", required=True, help="run directory: last.pt, best.pt, log.csv")
     parser.add_argument("--epochs", type=int, default=None, help="override the config's epochs")
     parser.add_argument("--device", default=None, help="auto, cpu or cuda[:i] (default: the config's)")
@@ -54,14 +55,15 @@ def train_config_for(config_path: str, data_dirs: str | list[str], epochs: int |
     cfg = to_dict(load_yaml(TrainConfig, resolve_config("perception", config_path)))
     model = cfg["model"]["model"]
     if "any" not in model["joint_types"]:
-        if len(dirs) > 1:
-            raise SystemExit(f"--data {' '.join(dirs)}: several datasets train one cross-category model, "
+        if len(set(categories)) > 1:
+            raise SystemExit(f"--data {' '.join(dirs)}: datasets of several categories "
+                             f"({', '.join(dict.fromkeys(categories))}) train one cross-category model, "
                              f"whose config has 'any' joint slots (--config capt_cross_category)")
         model.update(category_structure(categories[0]))
     else:
         for category in categories:
             _check_fits_slots(category, category_structure(category), model)
-    category = categories[0] if len(categories) == 1 else "+".join(categories)
+    category = "+".join(dict.fromkeys(categories))
     for key, value in {"epochs": epochs, "device": device, "seed": seed}.items():
         if value is not None:
             cfg[key] = value

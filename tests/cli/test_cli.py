@@ -185,6 +185,21 @@ def test_train_config_takes_the_command_line_overrides(tmp_path: Path) -> None:
         train_config_for("configs/perception/capt.yaml", str(data), None, None, -1)
 
 
+def test_train_config_takes_several_datasets_of_one_category_as_that_category(tmp_path: Path) -> None:
+    from capt_env.commands.train import train_config_for
+
+    dirs = []
+    for name, category in (("plain", "drawer_cabinet"), ("varied", "drawer_cabinet"), ("lids", "laptop")):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "manifest.json").write_text(json.dumps({"config": {"category": category}}))
+        dirs.append(str(tmp_path / name))
+    cfg, category = train_config_for("configs/perception/capt.yaml", dirs[:2], None, None)
+    assert category == "drawer_cabinet"
+    assert cfg.model.model.max_joints == 3  # the drawer cabinet's three drawers
+    with pytest.raises(SystemExit, match="several categories.*drawer_cabinet, laptop.*capt_cross_category"):
+        train_config_for("configs/perception/capt.yaml", dirs, None, None)
+
+
 def test_capt_without_motion_loss_differs_from_capt_in_the_motion_weight_only(tmp_path: Path) -> None:
     from capt_env.commands.train import train_config_for
 

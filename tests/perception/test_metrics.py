@@ -14,6 +14,7 @@ from perception.metrics import (
     direction_error_deg,
     line_distance,
     mean_iou,
+    median_table_markdown,
     segmentation_accuracy,
     state_error,
     summarise,
@@ -81,3 +82,17 @@ def test_summarise_and_table():
     drawer = next(line for line in lines if line.startswith("| drawer"))
     assert "| - | - | 1.00 |" in drawer  # no segmentation; position '-' for prismatic
     assert any(line.startswith("| Mean | capt") for line in lines)
+
+
+def test_median_table_reports_the_middle_error_not_the_mean_a_flip_carries():
+    door = [SampleResult("door", "capt", 1.0, 1.0, (JointResult(0, "revolute", e, 0.1, pos_m, state),))
+            for e, pos_m, state in ((0.2, 0.01, 2.0), (0.4, 0.03, 8.0), (179.0, 0.40, 60.0))]
+    drawer = [SampleResult("drawer", "capt", 1.0, 1.0, (JointResult(0, "prismatic", 3.0, None, None, s),))
+              for s in (0.01, 0.02, 0.09)]
+    s = summarise(door)
+    assert s["pos_median_m"] == [pytest.approx(0.03)] and s["state_median"] == [pytest.approx(8.0)]
+    assert math.isnan(summarise(drawer)["pos_median_m"][0])
+    lines = median_table_markdown(door + drawer).splitlines()
+    assert lines[0] == "| Dataset | Method | Dir median (deg) | Flipped | Pos median (cm) | State median |"
+    assert "| door | capt | 0.4 | 0.33 | 3.0 | 8.0 deg |" in lines
+    assert "| drawer | capt | 3.0 | 0.00 | - | 0.020 m |" in lines
