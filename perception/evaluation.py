@@ -37,9 +37,9 @@ from perception.metrics import (
     direction_error_deg,
     line_distance,
     mean_iou,
+    median_table_markdown,
     segmentation_accuracy,
     state_error,
-    median_table_markdown,
     table_markdown,
 )
 from perception.normalisation import Normalisation

@@ -230,8 +230,8 @@ def median_table_markdown(results: Sequence[SampleResult]) -> str:
         s = summarise(rs)
         slots = sorted({j.joint_index for r in rs for j in r.joints})
         units = [next(j.joint_type for r in rs for j in r.joints if j.joint_index == k) for k in slots]
-        states = [f"{v:.1f} deg" if t == "revolute" else f"{v:.3f} m" for v, t in zip(s["state_median"], units,
-                                                                                        strict=True)]
+        states = [f"{v:.1f} deg" if t == "revolute" else f"{v:.3f} m"
+                  for v, t in zip(s["state_median"], units, strict=True)]
         pos = [100 * v for v in s["pos_median_m"]]
         lines.append("| " + " | ".join([category, method, _fmt(s["dir_median"], 1), _fmt(s["dir_flipped"]),
                                         _fmt(pos, 1), ", ".join(states) or "-"]) + " |")

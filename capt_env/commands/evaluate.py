@@ -81,9 +81,11 @@ def run(args: argparse.Namespace) -> int:
         noise += (f"Stray points filtered before the network: {outlier_filter.neighbours} neighbours, "
                   f"std ratio {outlier_filter.std_ratio:g}.\n\n")
     source = f"Perception source: `{PERCEPTION_SOURCE}` (the network alone, no refiners).\n\n"
-    text = (f"{source}{pose}{noise}{result.table}\n\nMedian errors (a few flipped axes can carry a mean; "
-            f"position: distance between the axis lines):\n\n{result.medians}\n\nTime per input (median over >= {args.timing_clouds} "
-            f"clouds, device {args.device}):\n\n| method | ms |\n| --- | --- |\n{timing}\n")
+    medians = (f"Median errors (a few flipped axes can carry a mean; position: distance between the axis "
+               f"lines):\n\n{result.medians}")
+    text = (f"{source}{pose}{noise}{result.table}\n\n{medians}\n\nTime per input (median over >= "
+            f"{args.timing_clouds} clouds, device {args.device}):\n\n| method | ms |\n| --- | --- |\n"
+            f"{timing}\n")
     print(text)
     if args.markdown:
         Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
