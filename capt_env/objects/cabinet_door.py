@@ -62,7 +62,8 @@ def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     zh = z0 + handle_z * (z1 - z0)
     front = build_front(Front((xf - door_t, y0, z0), (xf, y1, z1), 0, -1.0, door_color,
                               (xf - door_t, free_y, zh), along=2, handle_length=handle_len * (z1 - z0),
-                              handle_thickness=handle_t, standoff=standoff, default_handle=handle_style),
+                              handle_thickness=handle_t, standoff=standoff, default_handle=handle_style,
+                              long_levers=True),
                         style)
     if style is not None and style.interior:
         body += cabinet_interior(width, depth, height, wall, [height * 0.5] if shelves else [], body_color,

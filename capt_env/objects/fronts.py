@@ -20,7 +20,7 @@ import numpy as np
 from capt_env.objects.geometry import quat_from_axis_angle, quat_from_x_to
 from capt_env.objects.parts import HANDLE_COLOR, RGBA, bar_handle, box_from_bounds, knob_handle
 from capt_env.objects.spec import Box, ConvexMesh, Cylinder, Shape
-from capt_env.objects.style import Style
+from capt_env.objects.style import Style, lever_standoff
 
 Vec3 = tuple[float, float, float]
 ARC_POINTS = 6  # per rounded corner
@@ -116,7 +116,9 @@ class Front:
     the category's handle (``default_handle``; a bar along axis ``along`` of ``handle_length`` by
     ``handle_thickness`` standing ``standoff`` off the face; a knob's cap ``knob_size`` across and
     ``knob_depth`` deep on a stem ``standoff - 0.01`` long). ``round`` marks a round door (a disc
-    inscribed in the slab's square, its axis along the normal). Metres."""
+    inscribed in the slab's square, its axis along the normal). ``long_levers``: a varied lever may
+    stand up to :data:`~capt_env.objects.style.LEVER_MAX_STANDOFF` off (a side-hinged door, whose
+    lever swings clear of the table and the body). Metres."""
 
     lo: Vec3
     hi: Vec3
@@ -133,6 +135,7 @@ class Front:
     knob_size: float = 0.028
     knob_depth: float = 0.02
     round: bool = False
+    long_levers: bool = False
 
 
 @dataclass
@@ -309,7 +312,7 @@ def _lever(f: Front, style: Style, panel: Panel) -> tuple[list[Box], list[Shape]
     d = sign * d
     length = max(length * s, 2 * t)
     face = max(panel.height(p), panel.height(p + d * length))
-    top = face + f.standoff
+    top = face + (lever_standoff(f.standoff, style) if f.long_levers else f.standoff)
     rose = _block(p + up * (panel.height(p) + 0.002), up, 0.004, 0.018, 0.004, up, f, f.handle_color,
                   style.cylinders)
     stem = _post(f, panel, p, top + 1e-4, 0.45 * t, up, style.cylinders)

@@ -22,6 +22,9 @@ HandleKind = Literal["bar", "knob", "recessed", "lever"]
 PANEL_SHAPES: tuple[PanelShape, ...] = ("box", "rounded", "chamfered", "curved")
 HANDLE_KINDS: tuple[HandleKind, ...] = ("bar", "knob", "recessed", "lever")
 _STYLE_STREAM = 7_411  # keeps the style generator apart from the shape parameters' one
+LEVER_MAX_STANDOFF = 0.13
+"""Metres: the longest stem a varied lever stands on, off its panel's face (door levers and the
+simulators' door files stand 6-13 cm off; cabinet bars 3-4.5 cm)."""
 
 
 @dataclass(frozen=True)
@@ -36,9 +39,11 @@ class GeometryVariation:
       cylinders (a washing machine's round door, bars, posts and knobs).
     - ``handles``: each instance's handle is a bar, a knob, a recessed pull (a pocket 2.8 cm high
       cut 60 % into a flat panel; the grasp point is the pocket's centre) or a lever (a stem and a
-      bar to one side), a quarter each; bars and levers lie along one of the panel's two axes on
-      half of the instances and at a uniform angle in (-pi/2, pi/2) radians on the others. A laptop
-      with a recessed pull has no lip. Eyeglasses keep their ear pieces.
+      bar to one side; on a side-hinged door, cabinet or washing machine, the stem uniform from
+      the category's handle standoff to :data:`LEVER_MAX_STANDOFF`), a quarter each; bars and
+      levers lie along one of the panel's two axes on half of the instances and at a uniform angle
+      in (-pi/2, pi/2) radians on the others. A laptop with a recessed pull has no lip. Eyeglasses
+      keep their ear pieces.
     - ``interiors``: inner structure of the base, seen when the part is open: one or two extra
       shelves and a divider in a cabinet, one or two wire racks in an oven, a drum of slats in a
       washing machine, frames between the drawers of a drawer cabinet and a divider in each drawer
@@ -60,7 +65,9 @@ class Style:
     """One instance's geometry choices (see :class:`GeometryVariation`). ``panel_size`` in [0, 1)
     places the panel shape's size within its range; ``handle`` None keeps the category's own kind;
     ``handle_angle`` (radians) turns bars and levers in the panel plane from the category's bar
-    direction; ``seed`` draws the interior's details (:meth:`rng`)."""
+    direction; ``lever_stem`` in [0, 1) places a lever's stem between the category's standoff and
+    :data:`LEVER_MAX_STANDOFF` (:func:`lever_standoff`); ``seed`` draws the interior's details
+    (:meth:`rng`)."""
 
     panel: PanelShape = "box"
     panel_size: float = 0.0
@@ -69,6 +76,7 @@ class Style:
     handle_angle: float = 0.0
     interior: bool = False
     seed: int = 0
+    lever_stem: float = 0.0
 
     def rng(self) -> np.random.Generator:
         """A fresh generator for the interior's details (the same every call)."""
@@ -89,6 +97,7 @@ def draw_style(category: str, instance_id: int, variation: GeometryVariation) ->
     turned = float(rng.uniform(-math.pi / 2, math.pi / 2))
     angle = float(rng.choice([0.0, math.pi / 2])) if aligned else turned
     seed = int(rng.integers(2**31))
+    lever_stem = float(rng.random())  # drawn last: the draws above are those of styles before it
     return Style(
         panel=panel if variation.panels else "box",
         panel_size=size,
@@ -97,4 +106,12 @@ def draw_style(category: str, instance_id: int, variation: GeometryVariation) ->
         handle_angle=angle if variation.handles else 0.0,
         interior=variation.interiors,
         seed=seed,
+        lever_stem=lever_stem if variation.handles else 0.0,
     )
+
+
+def lever_standoff(category_standoff: float, style: Style) -> float:
+    """Metres a lever's bar stands off its panel's face: ``category_standoff`` (the category's bar
+    standoff) at ``style.lever_stem`` 0, up to :data:`LEVER_MAX_STANDOFF` towards 1."""
+    low = min(category_standoff, LEVER_MAX_STANDOFF)
+    return low + style.lever_stem * (LEVER_MAX_STANDOFF - low)

@@ -83,7 +83,7 @@ def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     front = build_front(Front((x0, -half, zc - half), (x1, half, zc + half), 0, -1.0, door_color,
                               (x0, free_y, zc), along=2, handle_length=handle_len * size,
                               handle_thickness=handle_t, standoff=standoff, default_handle=handle_style,
-                              knob_size=0.03, round=shape == "round"),
+                              knob_size=0.03, round=shape == "round", long_levers=True),
                         style, own_panel)
     # the window lies on a flat face (none on a curved door or one cut for a recessed pull)
     flat = style is None or (style.panel != "curved" and style.handle != "recessed")

@@ -115,3 +115,28 @@ def test_varied_shapes_build_with_collision_shapes() -> None:
                 assert px.PhysxCollisionShapeConvexMesh in kinds
             if any(isinstance(s, Cylinder) for s in link.shapes):
                 assert px.PhysxCollisionShapeCylinder in kinds
+
+
+def _lever_reach(category: str, instance_id: int) -> float:
+    """Metres a varied lever's grasp point stands further off the front than the same instance's bar
+    (fronts face -x; handles-only variation keeps the flat panel, so the face is the same)."""
+    plain = make_object(category, instance_id)
+    lever = make_object(category, instance_id, GeometryVariation(handles=True))
+    return float(plain.grasp_point[0] - lever.grasp_point[0])
+
+
+def test_side_door_levers_stand_off_as_far_as_door_levers_do_and_others_stay_short() -> None:
+    from capt_env.objects.style import LEVER_MAX_STANDOFF
+
+    only_handles = GeometryVariation(handles=True)
+    for category, long_levers in (("cabinet_door", True), ("washing_machine", True), ("oven", False),
+                                  ("drawer_cabinet", False)):
+        ids = [i for i in range(0, 1000, 7) if draw_style(category, i, only_handles).handle == "lever"
+               and make_object(category, i).params.get("handle_style", "bar") == "bar"][:12]
+        reach = np.array([_lever_reach(category, i) for i in ids])
+        assert len(ids) >= 8, category
+        if long_levers:  # stems spread from the category's 3-4.5 cm up to 13 cm
+            assert reach.min() > -1e-6 and reach.max() < LEVER_MAX_STANDOFF - 0.03 + 1e-6, (category, reach)
+            assert reach.max() - reach.min() > 0.04, (category, reach)
+        else:
+            np.testing.assert_allclose(reach, 0.0, atol=1e-6, err_msg=category)
