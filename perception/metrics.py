@@ -180,6 +180,14 @@ def _fmt(v: float | list[float] | None, digits: int = 2) -> str:
     return f"{v:.{digits}f}"
 
 
+def _by_category_and_method(results: Sequence[SampleResult]) -> dict[tuple[str, str], list[SampleResult]]:
+    """The results grouped by (category, method), in the order they first occur."""
+    groups: dict[tuple[str, str], list[SampleResult]] = {}
+    for r in results:
+        groups.setdefault((r.category, r.method), []).append(r)
+    return groups
+
+
 TABLE_COLUMNS = ("Dataset", "Method", "PA", "mIoU", "Dir MED", "Dir AP5", "Dir AP10", "Pos AED", "Pos AP1",
                  "Pos AP5", "State MED", "State AP5", "State AP10", "ms/input")
 
@@ -188,9 +196,7 @@ def table_markdown(results: Sequence[SampleResult]) -> str:
     """The paper's Table I as Markdown: one row per (category, method), then a Mean row per method
     (mean over categories of the per-category values, joint by joint averaged). Multi-joint categories
     show one value per joint, comma-separated."""
-    groups: dict[tuple[str, str], list[SampleResult]] = {}
-    for r in results:
-        groups.setdefault((r.category, r.method), []).append(r)
+    groups = _by_category_and_method(results)
     categories = list(dict.fromkeys(r.category for r in results))
     methods = list(dict.fromkeys(r.method for r in results))
     keys = ["pa", "miou", "dir_med", "dir_ap5", "dir_ap10", "pos_aed", "pos_ap1", "pos_ap5", "state_med",
@@ -222,9 +228,7 @@ def median_table_markdown(results: Sequence[SampleResult]) -> str:
     """Median errors as Markdown, one row per (category, method): direction (degrees), the share of
     flipped axes, axis-line distance (centimetres, '-' for prismatic joints) and state ('deg' for a
     revolute joint, 'm' for a prismatic one). Multi-joint categories show one value per joint slot."""
-    groups: dict[tuple[str, str], list[SampleResult]] = {}
-    for r in results:
-        groups.setdefault((r.category, r.method), []).append(r)
+    groups = _by_category_and_method(results)
     lines = ["| " + " | ".join(MEDIAN_TABLE_COLUMNS) + " |", "|" + "---|" * len(MEDIAN_TABLE_COLUMNS)]
     for (category, method), rs in groups.items():
         s = summarise(rs)

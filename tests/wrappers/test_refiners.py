@@ -170,8 +170,8 @@ def test_edge_direction_turns_a_hinge_onto_the_rectangles_edge() -> None:
 
 def test_edge_direction_straightens_a_hinge_tilted_most_of_the_way_to_the_next_edge() -> None:
     """Every in-plane direction lies within 45 deg of one of a rectangle's edges; a hinge read 40 deg
-    off its edge (cabinet door seed 1 at reset: 42 deg after the line was put on the edge) is turned
-    onto it, not left tilted."""
+    off its edge (a tilted network hinge whose line was put on the door's edge kept its tilt) is
+    turned onto it, not left tilted."""
     points, labels = _door(np.random.default_rng(0))
     tilt = np.radians(40.0)  # in the door's plane
     draft = _draft(points, labels, _hinge((0.0, np.sin(tilt), -np.cos(tilt))))
