@@ -33,7 +33,9 @@ the closed state, and its child link is at rest.
 ``joint_state`` (rad or m), ``joint_limits``, ``joint_child_part``, ``joint_mask`` (which slots hold
 a joint: sub-scenes whose instances have fewer joints than the batch's most are padded, see
 :mod:`capt_env.tasks.object_batch`), plus per sub-scene ``target_joint`` (a slot index),
-``open_fraction``, ``grasp_point``, ``success``.
+``open_fraction``, ``grasp_point``, ``target_link_pos`` (the target part's centre of mass, metres:
+which part the task means, as ManiSkill's TurnFaucet gives it; not where its joint or handle is),
+``success``.
 In ``pointcloud`` mode the observation's ``pointcloud`` dict also carries ``part_label``: for each
 point the object part it lies on (0 = everything fixed to the base, ``k + 1`` = the part movable
 joint ``k`` moves, links joined by fixed joints counted as one part), or -1 for anything that is not
@@ -326,6 +328,14 @@ class OpenArticulatedEnv(BaseEnv):
         """(num_envs, 3) world-frame grasp point on each target part (handle centre or far edge), metres."""
         return self.object_batch.grasp_point()
 
+    def target_link_position(self) -> torch.Tensor:
+        """(num_envs, 3) world-frame centre of mass of each target joint's child link, metres: which
+        part to open when an object has several alike (a double door's leaves), the way ManiSkill's
+        TurnFaucet names its target switch (``target_link_pos``). It says nothing of where the part's
+        joint or handle is."""
+        link = self.object_batch.target_link
+        return (link.pose * link.cmass_local_pose).p
+
     def evaluate(self) -> dict[str, torch.Tensor]:
         cfg = self.task_config
         batch = self.object_batch
@@ -342,6 +352,7 @@ class OpenArticulatedEnv(BaseEnv):
             "target_joint": batch.tensor("target_joint").clone(),
             "open_fraction": open_fraction,
             "grasp_point": self.grasp_point(),
+            "target_link_pos": self.target_link_position(),
             "opened": opened,
             "success": opened & at_rest,
         }

@@ -60,8 +60,9 @@ def network_input(points: np.ndarray, num: int, rng: np.random.Generator) -> np.
 class Look:
     """One run of the network: its input ``points`` (M, 3), all isolated ``dense_points`` (K, 3) (or
     None), the ``target`` joint index, the network's output ``result`` (part labels, joints after
-    double voting), the ``model`` config it came from and the cameras' mean position ``viewpoint``
-    (3,) (or None). World frame, metres."""
+    double voting), the ``model`` config it came from, the cameras' mean position ``viewpoint``
+    (3,) and the task's ``target_hint`` (3,), the target part's centre of mass (each or None).
+    World frame, metres."""
 
     points: np.ndarray
     dense_points: np.ndarray | None
@@ -69,20 +70,23 @@ class Look:
     result: ArticulationEstimate
     model: Any
     viewpoint: np.ndarray | None = None
+    target_hint: np.ndarray | None = None
 
 
 def look(estimator: Any, points: np.ndarray, target: int, dense_points: np.ndarray | None = None,
-         viewpoint: np.ndarray | None = None) -> Look:
+         viewpoint: np.ndarray | None = None, target_hint: np.ndarray | None = None) -> Look:
     """Run ``estimator`` (a ``perception.inference.ArticulationEstimator``) on ``points`` (M, 3)."""
     points = np.asarray(points, dtype=np.float64)
     view = None if viewpoint is None else np.asarray(viewpoint, dtype=np.float64).reshape(3)
-    return Look(points, dense_points, int(target), estimator.predict(points), estimator.config.model, view)
+    hint = None if target_hint is None else np.asarray(target_hint, dtype=np.float64).reshape(3)
+    return Look(points, dense_points, int(target), estimator.predict(points), estimator.config.model, view,
+                hint)
 
 
 def network(seen: Look) -> Draft:
     """The network's own estimate of the target joint, as a draft the refiners can change."""
     return network_draft(seen.result, seen.points, seen.target, seen.model, seen.dense_points,
-                         seen.viewpoint)
+                         seen.viewpoint, seen.target_hint)
 
 
 # ------------------------------------------------------------------------------------ 3. refine

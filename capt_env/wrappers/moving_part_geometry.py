@@ -210,16 +210,18 @@ def double_door_seam(grasp: np.ndarray, other_handles: Sequence[np.ndarray], cen
                      max_height: float = 0.1) -> float | None:
     """Where (m across, unit ``across`` (3,) from ``centre`` (3,)) two doors meet, when one of
     ``other_handles`` (each (3,)) stands beside the ``grasp`` (3,) handle: at least ``min_apart`` m
-    from it across and within ``max_height`` m of its height along ``along`` (3,) (the two doors of
-    a double door carry their handles side by side near where they meet): half-way between them;
-    None when none does. World frame, metres."""
+    from it across, and off its height along ``along`` (3,) by at most ``max_height`` m or by less
+    than it stands across (the two doors of a double door carry their handles side by side near
+    where they meet; a long bar seen in part has its centre off its twin's height, and still stands
+    more beside it than above it): half-way between them; None when none does. World frame, metres."""
     s_grasp = float((grasp - centre) @ across)
     h_grasp = float((grasp - centre) @ along)
     beside = []
     for other in other_handles:
         d = np.asarray(other, dtype=np.float64) - centre
         s_other, h_other = float(d @ across), float(d @ along)
-        if abs(s_other - s_grasp) >= min_apart and abs(h_other - h_grasp) <= max_height:
+        apart, off_height = abs(s_other - s_grasp), abs(h_other - h_grasp)
+        if apart >= min_apart and off_height <= max(max_height, apart):
             beside.append(s_other)
     if not beside:
         return None

@@ -45,6 +45,14 @@ def _target(info: dict[str, Any]) -> int:
     return int(np.asarray(info["target_joint"]).reshape(-1)[0])
 
 
+def _target_hint(info: dict[str, Any]) -> np.ndarray | None:
+    """The task's ``target_link_pos`` (3,) (the target part's centre of mass, world frame), or None
+    when the env gives none."""
+    if "target_link_pos" not in info:
+        return None
+    return np.asarray(info["target_link_pos"], dtype=np.float64).reshape(-1, 3)[0]
+
+
 def ground_truth_estimate(info: dict[str, Any]) -> JointAxisEstimate:
     """The target joint's ground truth from a capt_env info dict (world frame), pivot made canonical."""
     k = _target(info)
@@ -131,8 +139,10 @@ class CaptSource:
     call) on the isolated object points, through ``pipeline``
     (:class:`~capt_env.wrappers.estimate_pipeline.EstimatePipeline`: network, refiners, fusion).
     ``name``: the source's name in tables (``capt_raw`` or ``capt``). The target joint's channel is
-    the env's target joint index. ``last_look`` is the latest run's input and network output
-    (None before the first), so other refiner lists can be scored on the same look.
+    the env's target joint index; the env's ``target_link_pos`` (the target part's centre of mass),
+    when given, chooses a double door's leaf (``refiners.handle.target_leaf_handle``). ``last_look``
+    is the latest run's input and network output (None before the first), so other refiner lists can
+    be scored on the same look.
     :meth:`reset` starts a new episode (forgets the fused looks).
     """
 
@@ -168,7 +178,8 @@ class CaptSource:
                  viewpoint: np.ndarray | None = None) -> JointAxisEstimate:
         if points is None:
             raise ValueError(f"the {self.name} source needs the object's points")
-        self.last_look = look(self._load(), points, _target(info), dense_points, viewpoint)
+        self.last_look = look(self._load(), points, _target(info), dense_points, viewpoint,
+                              _target_hint(info))
         return self.pipeline.estimate(self.last_look)
 
 

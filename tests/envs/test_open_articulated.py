@@ -348,3 +348,32 @@ def test_user_urdf_object_with_named_joint(tmp_path) -> None:
         env.close()
     with pytest.raises(ValueError, match="no_such_joint"):
         gym.make(GENERIC_ID, obs_mode="state", task={"object": str(path), "joint": "no_such_joint"})
+
+
+def test_info_names_the_target_part_by_its_centre_of_mass(tmp_path) -> None:
+    """``target_link_pos`` is the target drawer's centre: each drawer of a stack at its own height,
+    nearer its own handle than half the spacing between drawers (what tells the leaves of a double
+    door, or the drawers of a stack, apart)."""
+    from capt_env.objects.registry import make_object
+    from capt_env.objects.splits import instance_ids
+    from capt_env.objects.user_files import spec_to_urdf
+
+    spec = next(s for s in (make_object("drawer_cabinet", i) for i in instance_ids("drawer_cabinet", "train"))
+                if len(s.joints) == 3)
+    path = tmp_path / "stack.urdf"
+    path.write_text(spec_to_urdf(spec))
+    heights = []
+    for joint in spec.joints:
+        env = gym.make(GENERIC_ID, obs_mode="state", task={"object": str(path), "joint": joint.name,
+                                                            "cameras": [CAMERA]})
+        try:
+            _, info = env.reset(seed=0)
+            centre = np.asarray(info["target_link_pos"]).reshape(3)
+            grasp = np.asarray(info["grasp_point"]).reshape(3)
+            heights.append((float(centre[2]), float(grasp[2])))
+        finally:
+            env.close()
+    centres = [c for c, _ in heights]
+    assert centres == sorted(centres)  # drawers are numbered bottom up
+    spacing = min(np.diff(centres))
+    assert all(abs(c - g) < spacing / 2 for c, g in heights)

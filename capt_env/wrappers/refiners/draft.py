@@ -34,7 +34,9 @@ class Draft:
     when it labels fewer than 3), ``network`` its estimate of the target joint (``joint_index``,
     ``type``, ``direction``, ``pivot``, ``state``, ``confidence``), ``model`` the model's config
     (``joint_child_parts``, ``joint_types``), ``target`` the joint's index, ``dense_points`` (D, 3)
-    all isolated object points (or None), ``viewpoint`` (3,) the cameras' mean position (or None).
+    all isolated object points (or None), ``viewpoint`` (3,) the cameras' mean position (or None),
+    ``target_hint`` (3,) the target part's centre of mass as the task gives it (or None): it only
+    chooses between alike parts (a double door's leaves), never sets the estimate.
 
     Working geometry (refiners may replace it): ``handle_cloud`` the points handles are looked for
     among and ``handle_min_points`` the fewest points of a handle there; ``panel`` the flat panel the
@@ -66,6 +68,7 @@ class Draft:
     grasp: np.ndarray | None = None
     from_handle: bool = False
     viewpoint: np.ndarray | None = None
+    target_hint: np.ndarray | None = None
     other_handles: list[np.ndarray] = field(default_factory=list)
     fired: list[str] = field(default_factory=list)
     _plane: PartPlane | None = field(default=None, repr=False)
@@ -157,13 +160,15 @@ def moving_part_plane(points: np.ndarray, moving: np.ndarray, joint_type: str,
 
 
 def network_draft(result: ArticulationEstimate, points: np.ndarray, target: int, model: Any,
-                  dense_points: np.ndarray | None = None, viewpoint: np.ndarray | None = None) -> Draft:
+                  dense_points: np.ndarray | None = None, viewpoint: np.ndarray | None = None,
+                  target_hint: np.ndarray | None = None) -> Draft:
     """The draft of the network's estimate ``result`` of the cloud ``points`` (M, 3) for joint
     ``target`` (clipped to the joints the model has): its own type, direction, pivot, state and
     confidence; the moving part is the points labelled with the joint's child part (all points when
     fewer than 3 are, or the model names no child parts). ``model``: the model's config. A
     cross-category model reports only the slots it finds present: when the target slot is not among
-    them, the most confident joint it found stands in."""
+    them, the most confident joint it found stands in. ``target_hint`` (3,): the target part's centre
+    of mass, when the task gives it."""
     points = np.asarray(points, dtype=np.float64)
     by_slot = {j.joint_index: j for j in result.joints}
     k = min(int(target), max(by_slot))
@@ -181,4 +186,4 @@ def network_draft(result: ArticulationEstimate, points: np.ndarray, target: int,
                  dense_points=dense, handle_cloud=points, handle_min_points=MIN_HANDLE_POINTS,
                  panel=moving, joint_type=joint.type, direction=unit(joint.direction),
                  pivot=np.asarray(joint.pivot, dtype=np.float64), state=float(joint.state),
-                 confidence=float(joint.confidence), viewpoint=viewpoint)
+                 confidence=float(joint.confidence), viewpoint=viewpoint, target_hint=target_hint)

@@ -13,6 +13,10 @@ bar is centred across its thickness too (the cameras see one side of it), and it
 its thickness behind its front (the posts that hold it off the face pull a centroid behind it),
 except on a part swinging about a horizontal hinge (an oven door, a lid): measured, that moved an
 oven's grasp point off its bar.
+When the task names its target part (``Draft.target_hint``, the part's centre of mass) and the best
+handle has a twin on another leaf (a double door segmented as one part), the handle nearest that
+centre is taken (:func:`target_leaf_handle`): the leaves look alike, and only the task says which
+one it means.
 When nothing stands in that band, the search runs again out to ``far_standoff`` (13 cm): a bar on
 long posts stands farther out (Franka Kitchen's microwave: a 2 cm bar on 5.8 cm posts, seen 9-12 cm
 off the plane fitted to its door, whose glass lies behind the door's front), and a second search only
@@ -34,6 +38,7 @@ from typing import ClassVar
 import numpy as np
 
 from capt_common.typed_yaml import require
+from capt_env.wrappers.estimate import unit
 from capt_env.wrappers.grasp_candidates import GraspCandidate, GraspCandidateConfig, find_grasp_candidates
 from capt_env.wrappers.moving_part_geometry import PartPlane
 from capt_env.wrappers.refiners.draft import Draft
@@ -85,8 +90,10 @@ class Handle:
             handles = self.handles(draft, face, c.far_standoff)
         if not handles:
             return False
-        draft.grasp, draft.from_handle = handles[0].point, True
-        draft.other_handles = [g.point for g in handles[1:] if twin(g, handles[0])]
+        hinge = draft.direction if draft.joint_type == "revolute" else None
+        chosen = target_leaf_handle(handles, face, draft.target_hint, hinge)
+        draft.grasp, draft.from_handle = chosen.point, True
+        draft.other_handles = [g.point for g in handles if g is not chosen and twin(g, chosen)]
         return True
 
     def handles(self, draft: Draft, face: PartPlane, max_standoff: float) -> list[GraspCandidate]:
@@ -119,6 +126,38 @@ def twin(other: GraspCandidate, handle: GraspCandidate) -> bool:
     if other.kind != handle.kind:
         return False
     return other.kind != "bar" or abs(float(other.bar_axis @ handle.bar_axis)) >= np.cos(TWIN_BAR_ANGLE)
+
+
+LEAF_MIN_APART = 0.06
+"""m: two twin handles at least this far apart in the face's plane are on two leaves (the
+``min_apart`` of :func:`~capt_env.wrappers.moving_part_geometry.double_door_seam`)."""
+
+
+def target_leaf_handle(handles: list[GraspCandidate], face: PartPlane, target_hint: np.ndarray | None,
+                       hinge: np.ndarray | None = None) -> GraspCandidate:
+    """The handle to grasp among ``handles`` (best first): the best one, or, when the task names its
+    target part by ``target_hint`` (3,) (its centre of mass) and twins of the best handle stand at
+    least ``LEAF_MIN_APART`` from it on the face (a double door's two leaves), the one of the best and
+    those twins nearest the hint across the ``hinge`` direction (3,) (in the face's plane when None):
+    a double door's leaves lie side by side across their hinges, each with its handle on its own
+    side of the seam, while a handle seen in part has its centre off the leaf's height. The hint
+    picks a leaf, never a point. World frame, metres."""
+    best = handles[0]
+    if target_hint is None:
+        return best
+    axes = face.in_plane
+    if hinge is not None:
+        along = hinge - float(hinge @ face.outward) * face.outward
+        if np.linalg.norm(along) > 0.5:  # a hinge lying in the face (within 60 deg of it)
+            axes = unit(np.cross(face.outward, along))[None, :]
+
+    def coords(p: np.ndarray) -> np.ndarray:
+        return (np.asarray(p, dtype=np.float64) - face.centre) @ axes.T
+
+    leaves = [best] + [g for g in handles[1:] if twin(g, best) and float(
+        np.linalg.norm((g.point - best.point) @ face.in_plane.T)) >= LEAF_MIN_APART]
+    hint = coords(target_hint)
+    return min(leaves, key=lambda g: float(np.linalg.norm(coords(g.point) - hint)))
 
 
 def over_part(point: np.ndarray, part_points: np.ndarray, plane: PartPlane, margin: float) -> bool:

@@ -1,9 +1,9 @@
 """Refiner ``hinge_on_edge``: a flat part's hinge line lies on its edge away from the handle.
 
 Geometric reason: a closed door, lid or oven door turns about a line in (or just behind) its own
-plane along its edge farthest from the handle. A panel with a twin of the grasp's handle beside it
-(:func:`~capt_env.wrappers.refiners.handle.twin`), at its height, is two coplanar doors meeting
-between their handles (a double door the network reads as one part; Franka Kitchen's hinged
+plane along its edge farthest from the handle. A panel with a twin of the grasp's handle
+(:func:`~capt_env.wrappers.refiners.handle.twin`) beside it rather than above it is two coplanar
+doors meeting between their handles (a double door the network reads as one part; Franka Kitchen's hinged
 cabinet): the grasp's door is hinged on the panel's edge on its side of that seam (``pair_doors``).
 The direction is projected into the part's plane
 (its in-plane component kept, so the network still decides which edge), and the network's line is
@@ -38,7 +38,7 @@ class HingeOnEdgeConfig:
     edge_quantile: float = 0.02
     min_aspect: float = 0.25
     pair_doors: bool = True
-    """A twin of the grasp's handle beside it, at its height, makes the panel a double door: the
+    """A twin of the grasp's handle beside it (``double_door_seam``) makes the panel a double door: the
     grasp's door is hinged on the panel's edge on its side of the seam between them."""
 
     def validate(self) -> None:
