@@ -20,7 +20,9 @@ Keys of a shard holding S samples of N points and J joint slots (world frame, me
     category (S,) str             category name
     instance_id (S,) int64        object instance (splits are by instance)
 
-Other keys (e.g. ``target_joint``, ``camera_eye``) are ignored. A single-sample ``.npz`` holds the same
+``target_joint`` (S,) int64, the task's joint, is loaded when every shard has it (scoring a model with
+fewer joint slots than an object has joints: :func:`target_joint_only`); other keys (e.g.
+``camera_eye``) are ignored. A single-sample ``.npz`` holds the same
 keys without the leading S axis (:meth:`Sample.save` / :meth:`Sample.load`).
 
 :class:`CaptShardDataset` loads a split into memory, and for item i of epoch e draws its randomness from
@@ -51,6 +53,8 @@ from perception.normalisation import Normalisation
 SAMPLE_KEYS = ("points", "part_labels", "joint_types", "joint_dirs", "joint_pivots", "joint_states",
                "joint_limits", "joint_child_part", "joint_mask", "category", "instance_id")
 PRISMATIC = JOINT_TYPE_CODES["prismatic"]
+TARGET_KEY = "target_joint"
+"""The task's joint of each sample (``capt generate`` writes it); loaded when every shard has it."""
 
 
 @dataclass
@@ -134,7 +138,7 @@ def load_split(data_dir: str | Path, split: str) -> dict[str, np.ndarray]:
     files = sorted((Path(data_dir) / split).glob("shard_*.npz"))
     if not files:
         raise FileNotFoundError(f"no shard_*.npz files in {Path(data_dir) / split}")
-    parts: dict[str, list[np.ndarray]] = {k: [] for k in SAMPLE_KEYS}
+    parts: dict[str, list[np.ndarray]] = {k: [] for k in (*SAMPLE_KEYS, TARGET_KEY)}
     for f in files:
         with np.load(f, allow_pickle=False) as z:
             missing = [k for k in SAMPLE_KEYS if k not in z.files]
@@ -142,18 +146,59 @@ def load_split(data_dir: str | Path, split: str) -> dict[str, np.ndarray]:
                 raise ValueError(f"{f} lacks keys {missing}")
             for k in SAMPLE_KEYS:
                 parts[k].append(z[k])
+            if TARGET_KEY in z.files:
+                parts[TARGET_KEY].append(z[TARGET_KEY])
+    if len(parts[TARGET_KEY]) < len(files):  # the target joint is known for every shard or not at all
+        del parts[TARGET_KEY]
     return {k: np.concatenate(v) for k, v in parts.items()}
+
+
+JOINT_KEYS = ("joint_types", "joint_dirs", "joint_pivots", "joint_states", "joint_limits", "joint_child_part",
+              "joint_mask")
+"""The stacked arrays with a joint axis (axis 1)."""
+
+
+TARGET_ONLY_KEY = "target_only"
+"""(S,) bool: the sample was cut to its target joint by :func:`target_joint_only`."""
+
+
+def target_joint_only(a: dict[str, np.ndarray], num_joints: int) -> dict[str, np.ndarray]:
+    """Each sample with a joint in a slot ``>= num_joints`` keeps only its target joint, moved to slot
+    ``min(target, num_joints - 1)`` (the slot the estimate pipeline reads a target from), its part
+    relabelled that slot's part (slot + 1) and every other moving part counted as fixed (0): what a
+    model with ``num_joints`` slots can be scored on (a one-door model on one leaf of a double door).
+    Other samples are unchanged; ``TARGET_ONLY_KEY`` marks the changed ones. Without
+    ``target_joint`` the arrays are returned as they are (:func:`fit_joint_slots` then refuses)."""
+    if TARGET_KEY not in a:
+        return a
+    over = np.flatnonzero(a["joint_mask"][:, num_joints:].any(axis=1))
+    out = {k: v.copy() for k, v in a.items()}
+    out[TARGET_ONLY_KEY] = np.zeros(len(a["joint_mask"]), dtype=bool)
+    out[TARGET_ONLY_KEY][over] = True
+    for i in over:
+        t = int(a[TARGET_KEY][i])
+        slot = min(t, num_joints - 1)
+        for k in JOINT_KEYS:
+            row = out[k][i]
+            row[:] = -1 if k in ("joint_types", "joint_child_part") else 0
+            row[slot] = a[k][i, t]
+        out["joint_child_part"][i, slot] = slot + 1
+        labels = a["part_labels"][i]
+        out["part_labels"][i] = np.where(labels == a["joint_child_part"][i, t], slot + 1,
+                                         np.where(labels > 0, 0, labels))
+        out[TARGET_KEY][i] = slot
+    return out
 
 
 def fit_joint_slots(a: dict[str, np.ndarray], num_joints: int) -> dict[str, np.ndarray]:
     """Cut or pad the joint axis (axis 1 of stacked joint arrays) to ``num_joints`` slots; refuses to drop a
-    slot that holds a joint."""
+    slot that holds a joint (:func:`target_joint_only` makes such samples fit for scoring)."""
     out = dict(a)
     j = a["joint_mask"].shape[1]
     if j > num_joints and a["joint_mask"][:, num_joints:].any():
-        raise ValueError(f"data has joints in slots >= {num_joints}; raise model.max_joints")
-    for k in ("joint_types", "joint_dirs", "joint_pivots", "joint_states", "joint_limits", "joint_child_part",
-              "joint_mask"):
+        raise ValueError(f"data has joints in slots >= {num_joints}; raise model.max_joints (training), "
+                         f"or score the target joint only (capt evaluate does)")
+    for k in JOINT_KEYS:
         v = a[k][:, :num_joints]
         if j < num_joints:
             fill = -1 if k in ("joint_types", "joint_child_part") else 0
@@ -280,15 +325,22 @@ def prepare_sample(sample: Sample, num_points: int, rng: np.random.Generator) ->
     }
 
 
-def load_splits(data_dirs: Sequence[str | Path], split: str, num_joints: int) -> dict[str, np.ndarray]:
+def load_splits(data_dirs: Sequence[str | Path], split: str, num_joints: int,
+                target_only: bool = False) -> dict[str, np.ndarray]:
     """:func:`load_split` of every directory, each fitted to ``num_joints`` slots, concatenated (the
-    training set of a cross-category model: one directory per category)."""
-    arrays = [fit_joint_slots(load_split(d, split), num_joints) for d in data_dirs]
+    training set of a cross-category model: one directory per category). ``target_only``: a sample
+    with more joints than slots keeps its target joint only (:func:`target_joint_only`; for scoring,
+    never for training)."""
+    loaded = [load_split(d, split) for d in data_dirs]
+    if target_only:
+        loaded = [target_joint_only(a, num_joints) for a in loaded]
+    arrays = [fit_joint_slots(a, num_joints) for a in loaded]
     shapes = {a["points"].shape[1:] for a in arrays}
     if len(shapes) > 1:
         raise ValueError(f"the datasets {[str(d) for d in data_dirs]} store clouds of different sizes "
                          f"{sorted(shapes)}; generate them with one num_points")
-    return {k: np.concatenate([a[k] for a in arrays]) for k in arrays[0]}
+    common = [k for k in arrays[0] if all(k in a for a in arrays)]
+    return {k: np.concatenate([a[k] for a in arrays]) for k in common}
 
 
 class CaptShardDataset(Dataset):
@@ -296,18 +348,22 @@ class CaptShardDataset(Dataset):
     cross-category model) as training tensors (see module docstring). ``max_samples`` keeps
     the first samples only. ``pose`` puts every sample in its fixed seeded pose first (see
     :func:`posed_sample`; validation and test clouds), before any augmentation. ``sensor_noise`` is added
-    to augmented clouds only (:func:`add_sensor_noise`). Call :meth:`set_epoch` each epoch to change the
+    to augmented clouds only (:func:`add_sensor_noise`). ``target_only`` (scoring only): a sample with
+    more joints than the model has slots keeps its target joint (:func:`target_joint_only`;
+    :attr:`target_only_count` counts them). Call :meth:`set_epoch` each epoch to change the
     augmentation draw."""
 
     def __init__(self, data_dir: str | Path | Sequence[str | Path], split: str, model: ModelConfig,
                  augment: bool = False, seed: int = 0, max_samples: int | None = None,
-                 rotation: str = "so3", pose: str = "world", sensor_noise: Corruption | None = None) -> None:
+                 rotation: str = "so3", pose: str = "world", sensor_noise: Corruption | None = None,
+                 target_only: bool = False) -> None:
         check_pose(pose)
         dirs = [data_dir] if isinstance(data_dir, (str, Path)) else list(data_dir)
-        arrays = load_splits(dirs, split, model.max_joints)
+        arrays = load_splits(dirs, split, model.max_joints, target_only)
         if max_samples is not None:
             arrays = {k: v[:max_samples] for k, v in arrays.items()}
         self.arrays = arrays
+        self.target_only_count = int(arrays[TARGET_ONLY_KEY].sum()) if TARGET_ONLY_KEY in arrays else 0
         self.num_points = model.num_points
         self.augment = augment
         self.rotation = rotation

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import statistics
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -55,6 +55,9 @@ class EvaluationResult:
     median_ms: dict[str, float]
     table: str
     medians: str
+    target_only: dict[str, int] = field(default_factory=dict)
+    """Per method, the clouds with more joints than its model's slots, scored on their target joint
+    only (:func:`perception.data.target_joint_only`)."""
 
 
 def score_sample(est: ArticulationEstimate, sample: Sample, method: str, has_seg: bool) -> SampleResult:
@@ -116,9 +119,13 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
                                                est.seed, double_voting=False, outlier_filter=outlier_filter)))
     results: list[SampleResult] = []
     median_ms: dict[str, float] = {}
+    target_only: dict[str, int] = {}
     for method, est in runs:
         cfg = est.config.model
-        ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples, pose=test_pose)
+        ds = CaptShardDataset(data_dir, split, cfg, augment=False, max_samples=max_samples, pose=test_pose,
+                              target_only=True)
+        if ds.target_only_count:
+            target_only[method] = ds.target_only_count
         samples = [ds.posed(i) for i in range(len(ds))]
         clean = [s.object_points() for s in samples]
         clouds = [corrupt_cloud(c, i, corruption) for i, c in enumerate(clean)] if corruption else clean
@@ -134,4 +141,5 @@ def evaluate(checkpoints: Sequence[str | Path], data_dir: str | Path, split: str
             results.append(score_sample(pred, s, method, cfg.has_segmentation))
         times += [est.predict(clouds[i % len(clouds)]).latency_ms for i in range(timing_clouds - len(times))]
         median_ms[method] = statistics.median(times)
-    return EvaluationResult(results, median_ms, table_markdown(results), median_table_markdown(results))
+    return EvaluationResult(results, median_ms, table_markdown(results), median_table_markdown(results),
+                            target_only)

@@ -120,3 +120,33 @@ def test_yaw_rotation_keeps_up_direction() -> None:
         np.testing.assert_allclose(rot @ rot.T, np.eye(3), atol=1e-12)
     full = random_rotation(rng, "so3")
     assert abs((full @ np.array([0.0, 0.0, 1.0]))[2]) < 1.0
+
+
+def _two_door_arrays() -> dict[str, np.ndarray]:
+    """One stacked sample of a double door: base (0), left door (1, joint 0), right door (2, joint 1),
+    the task's target the right door."""
+    return {
+        "part_labels": np.array([[0, 0, 1, 1, 2, 2, -1]]),
+        "joint_types": np.array([[0, 0]]), "joint_dirs": np.array([[[0.0, 0, -1], [0, 0, 1]]]),
+        "joint_pivots": np.array([[[0.0, -0.4, 0], [0, 0.4, 0]]]), "joint_states": np.array([[0.1, 0.3]]),
+        "joint_limits": np.array([[[0.0, 1.5], [0, 1.5]]]), "joint_child_part": np.array([[1, 2]]),
+        "joint_mask": np.array([[True, True]]), "target_joint": np.array([1]),
+    }
+
+
+def test_a_model_with_fewer_slots_is_scored_on_the_target_joint_only() -> None:
+    from perception.data import TARGET_ONLY_KEY, fit_joint_slots, target_joint_only
+
+    a = _two_door_arrays()
+    with pytest.raises(ValueError, match="slots >= 1"):  # training never drops a joint
+        fit_joint_slots(a, 1)
+    out = fit_joint_slots(target_joint_only(a, 1), 1)
+    # the right door in the one slot, its part that slot's part, the left door counted as fixed
+    assert out["joint_mask"].tolist() == [[True]] and out["target_joint"].tolist() == [0]
+    np.testing.assert_allclose(out["joint_dirs"][0, 0], [0, 0, 1])
+    assert out["joint_states"][0, 0] == pytest.approx(0.3) and out["joint_child_part"].tolist() == [[1]]
+    assert out["part_labels"].tolist() == [[0, 0, 0, 0, 1, 1, -1]]
+    assert out[TARGET_ONLY_KEY].tolist() == [True]
+    # a model with a slot for every joint scores the sample as it is
+    kept = fit_joint_slots(target_joint_only(a, 2), 2)
+    assert kept["part_labels"].tolist() == a["part_labels"].tolist() and not kept[TARGET_ONLY_KEY].any()
