@@ -15,8 +15,8 @@ except on a part swinging about a horizontal hinge (an oven door, a lid): measur
 oven's grasp point off its bar.
 When the task names its target part (``Draft.target_hint``, the part's centre of mass) and the best
 handle has a twin on another leaf (a double door segmented as one part), the handle nearest that
-centre is taken (:func:`target_leaf_handle`): the leaves look alike, and only the task says which
-one it means.
+centre across the hinge is taken (:func:`target_leaf_handle`): the leaves look alike, and only the
+task says which one it means.
 When nothing stands in that band, the search runs again out to ``far_standoff`` (13 cm): a bar on
 long posts stands farther out (Franka Kitchen's microwave: a 2 cm bar on 5.8 cm posts, seen 9-12 cm
 off the plane fitted to its door, whose glass lies behind the door's front), and a second search only
