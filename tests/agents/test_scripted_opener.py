@@ -1188,7 +1188,8 @@ def test_a_hand_that_ran_off_a_part_that_stayed_put_grasps_again_turned() -> Non
 
 def test_the_approach_does_not_chase_a_grasp_point_that_jumps_once_the_hand_hides_the_handle() -> None:
     # Franka Kitchen's microwave with CAPT: with the hand at the bar the cameras saw its ends above
-    # and below the fingers, and the grasp point jumped between them until the approach was blocked
+    # and below the fingers, and the grasp point jumped between them until the approach was blocked;
+    # Meta-World's lever door: the lever's end, seen on two looks running, is worth following
     from agents.scripted.phases.reach import Approach
 
     door = JointAxisEstimate("revolute", np.array([0.0, 0.0, 1.0]), np.array([0.1, -0.2, 0.2]), 0.0,
@@ -1208,6 +1209,15 @@ def test_the_approach_does_not_chase_a_grasp_point_that_jumps_once_the_hand_hide
     approach.goal(ctx, door)
     ctx.now.p = door.grasp_point + [-0.02, 0.0, 0.0]  # the fingers at the bar
     np.testing.assert_allclose(approach.goal(ctx, jumped)[0], aimed, atol=1e-9)  # 10 cm off: not followed
+    np.testing.assert_allclose(approach.goal(ctx, jumped)[0], aimed, atol=1e-9)  # the same look again
+    # the bar's other end on the next look, then back: never two looks running
+    np.testing.assert_allclose(approach.goal(ctx, moved([0.0, -0.1, 0.0]))[0], aimed, atol=1e-9)
+    np.testing.assert_allclose(approach.goal(ctx, jumped)[0], aimed, atol=1e-9)
+    # a second look that agrees with the last one (a lever's end seen twice): followed
+    again = moved([0.0, 0.11, 0.0])
+    np.testing.assert_allclose(approach.goal(ctx, again)[0], aimed + [0.0, 0.11, 0.0], atol=1e-6)
+    approach = Approach("reached")
+    approach.goal(ctx, door)
     drifted = moved([0.0, 0.02, 0.0])
     np.testing.assert_allclose(approach.goal(ctx, drifted)[0], aimed + [0.0, 0.02, 0.0], atol=1e-6)
     # a fresh approach (a new grasp) follows whatever it is given first
