@@ -8,8 +8,6 @@ grips, how the hand is turned, the approach gap and whether the finger orders ar
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from agents.scripted.geometry import axis_angle_matrix, out_of_sweep
@@ -113,41 +111,12 @@ class PreGrasp(_Reach):
 
 
 class Approach(_Reach):
-    """Advance ``approach.grasp_depth`` past the grasp point; then close. Once the hand is within
-    ``approach.rechoose_grasp_m`` of the grasp point it aims at, a grasp point seen farther than that
-    from it is followed only when two looks running agree on it (:meth:`aimed`): the hand at the
-    handle hides it, and single looks then find the handle's ends beside the fingers or something
-    else. Farther out the hand follows any new one (a handle first seen on a later look)."""
+    """Advance ``approach.grasp_depth`` past the grasp point; then close."""
 
     phase = Phase.APPROACH
 
-    def __init__(self, why: str | None = None, **log_extra: Any) -> None:
-        super().__init__(why, **log_extra)
-        self._aimed: JointAxisEstimate | None = None
-        self._jumped: np.ndarray | None = None  # the last look's grasp point not followed
-
-    def aimed(self, ctx: OpenerContext, est: JointAxisEstimate) -> JointAxisEstimate:
-        """``est``, unless the hand is within ``approach.rechoose_grasp_m`` of the grasp point of the
-        last estimate followed, ``est``'s lies farther than that from it, and the look before (a
-        distinct grasp point: estimates repeat between looks) did not see it within that distance
-        too (then the estimate followed last; 0: always ``est``)."""
-        near = ctx.cfg.approach.rechoose_grasp_m
-        point = np.asarray(est.grasp_point, dtype=np.float64)
-        if self._aimed is None or near <= 0 or ctx.now is None:
-            self._aimed, self._jumped = est, None
-            return est
-        aimed_at = np.asarray(self._aimed.grasp_point, dtype=np.float64)
-        hand_there = float(np.linalg.norm(ctx.now.p - aimed_at)) <= near
-        if not hand_there or float(np.linalg.norm(point - aimed_at)) <= near:
-            self._aimed, self._jumped = est, None
-        elif self._jumped is not None and 1e-9 < float(np.linalg.norm(point - self._jumped)) <= near:
-            self._aimed, self._jumped = est, None  # a second look agrees: the handle is there
-        elif self._jumped is None or float(np.linalg.norm(point - self._jumped)) > 1e-9:
-            self._jumped = point.copy()
-        return self._aimed
-
     def goal(self, ctx: OpenerContext, est: JointAxisEstimate) -> tuple[np.ndarray, float]:
-        return self.along_approach(ctx, self.aimed(ctx, est), ctx.cfg.approach.grasp_depth)
+        return self.along_approach(ctx, est, ctx.cfg.approach.grasp_depth)
 
     def next(self, ctx: OpenerContext, est: JointAxisEstimate) -> OpenerPhase:
         return grasp.Close(ctx.move.reach_why)
