@@ -207,13 +207,15 @@ def opening_direction(joint_type: str, direction: np.ndarray, pivot: np.ndarray,
 
 def double_door_seam(grasp: np.ndarray, other_handles: Sequence[np.ndarray], centre: np.ndarray,
                      across: np.ndarray, along: np.ndarray, min_apart: float = 0.06,
-                     max_height: float = 0.1) -> float | None:
+                     max_height: float = 0.1, beside_slope: float = 0.75) -> float | None:
     """Where (m across, unit ``across`` (3,) from ``centre`` (3,)) two doors meet, when one of
     ``other_handles`` (each (3,)) stands beside the ``grasp`` (3,) handle: at least ``min_apart`` m
-    from it across, and off its height along ``along`` (3,) by at most ``max_height`` m or by less
-    than it stands across (the two doors of a double door carry their handles side by side near
-    where they meet; a long bar seen in part has its centre off its twin's height, and still stands
-    more beside it than above it): half-way between them; None when none does. World frame, metres."""
+    from it across, and off its height along ``along`` (3,) by at most ``max_height`` m or by at most
+    ``beside_slope`` times what it stands across (the two doors of a double door carry their handles
+    side by side near where they meet; a long bar seen in part has its centre off its twin's height,
+    and still stands clearly more beside it than above it: within 37 deg of level, clear of the
+    45-deg diagonal where neither holds): half-way between them; None when none does. World frame,
+    metres."""
     s_grasp = float((grasp - centre) @ across)
     h_grasp = float((grasp - centre) @ along)
     beside = []
@@ -221,7 +223,7 @@ def double_door_seam(grasp: np.ndarray, other_handles: Sequence[np.ndarray], cen
         d = np.asarray(other, dtype=np.float64) - centre
         s_other, h_other = float(d @ across), float(d @ along)
         apart, off_height = abs(s_other - s_grasp), abs(h_other - h_grasp)
-        if apart >= min_apart and off_height <= max(max_height, apart):
+        if apart >= min_apart and off_height <= max(max_height, beside_slope * apart):
             beside.append(s_other)
     if not beside:
         return None
