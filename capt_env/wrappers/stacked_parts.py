@@ -57,9 +57,14 @@ def handle_groups(object_points: np.ndarray, front_points: np.ndarray, plane: Pa
 
 
 def kth_handle_from_bottom(object_points: np.ndarray, front_points: np.ndarray, k: int,
-                           plane: PartPlane | None = None, min_points: int = 3) -> np.ndarray | None:
+                           plane: PartPlane | None = None, min_points: int = 3,
+                           target_height: float | None = None) -> np.ndarray | None:
     """Centre (3,) of the ``k``-th handle from the bottom on a stack's front (see
     :func:`handle_groups`), world frame, metres; None when fewer than ``k + 1`` handles are seen.
+    With ``target_height`` (m, world z of the target part's centre, when the task names it) the
+    handle nearest that height instead, whatever ``k`` (a user file numbers its drawers in any order;
+    a drawer's handle sits on its front, within half a drawer's height of its centre); None when no
+    handle is seen.
     The centre is the middle of the handle's extent along its main direction (a bar's visible
     points are denser at one end) and across it in the front's plane (a camera sees one side of a
     bar), over the handle's outer layer only (:func:`~capt_env.wrappers.moving_part_geometry.outer_layer`:
@@ -70,7 +75,10 @@ def kth_handle_from_bottom(object_points: np.ndarray, front_points: np.ndarray, 
     if plane is None:
         return None
     groups = handle_groups(object_points, front_points, plane=plane, min_points=min_points)
-    if len(groups) <= k:
+    if target_height is not None and groups:
+        handle = min(groups, key=lambda g: abs(float(np.mean(g @ _UP)) - target_height))
+    elif len(groups) <= k:
         return None
-    handle = groups[k]
+    else:
+        handle = groups[k]
     return bar_centre(handle[outer_layer(handle, plane)], plane.outward)

@@ -114,6 +114,17 @@ def test_the_bottom_drawer_is_found_when_the_segmented_stack_is_not_flat() -> No
     np.testing.assert_allclose(est.grasp_point, [-0.03, 0.0, 0.09], atol=0.015)  # not between two bars
 
 
+@pytest.mark.parametrize("centre_z, handle_z", [(0.09, 0.09), (0.21, 0.21), (0.31, 0.33)])
+def test_a_stack_numbered_in_any_order_grasps_the_drawer_the_task_names(centre_z: float,
+                                                                        handle_z: float) -> None:
+    # a user file's drawer joints need not run bottom up: joint 0 here is whichever drawer the
+    # task's target part (its centre of mass, near its handle's height) says
+    points, labels = _three_drawer_cloud(np.random.default_rng(0))
+    source = _capt(_StackNetwork(labels))
+    info = {"target_joint": np.array([0]), "target_link_pos": np.array([[0.2, 0.0, centre_z]])}
+    np.testing.assert_allclose(source.estimate(points, info).grasp_point, [-0.03, 0.0, handle_z], atol=0.015)
+
+
 def test_a_low_handle_with_few_points_still_counts_in_a_stack() -> None:
     """Drawer seed 30: the bottom drawer's bar showed 26 dense points where a lone handle needs 48,
     so the stack's lowest handle was the middle drawer's. Dense points 4x the model's input: a

@@ -8,8 +8,11 @@ drawers' union as segmented, or the target drawer's alone when that union is not
 gave a drawer some of the carcass's top or side), and it must face along the slide. A handle in a
 stack needs only ``handle_share`` of the points a lone handle does: a low or partly hidden bar shows
 few points, and counting from the bottom, a missed low handle names the next one up.
+When the task names its target part (``Draft.target_hint``, the part's centre of mass) the handle
+nearest that height is the target's instead: a user file numbers its drawers in any order.
 Must not fire: a revolute joint, a model with fewer than two prismatic joints, a front that is not
-flat or does not face along the slide, or fewer than k + 1 handles in view (the label decides).
+flat or does not face along the slide, or fewer than k + 1 handles in view (none, with the target
+part named; the label decides).
 """
 
 from __future__ import annotations
@@ -39,13 +42,14 @@ class StackedPartsConfig:
 
 
 def stacked_handle(points: np.ndarray, handle_cloud: np.ndarray, min_points: int, labels: np.ndarray,
-                   model: Any, k: int, direction: np.ndarray,
-                   config: StackedPartsConfig) -> tuple[PartPlane | None, np.ndarray | None]:
+                   model: Any, k: int, direction: np.ndarray, config: StackedPartsConfig,
+                   target_hint: np.ndarray | None = None) -> tuple[PartPlane | None, np.ndarray | None]:
     """(front plane, centre (3,) of the k-th handle from the bottom among ``handle_cloud``) of a
     stack of prismatic parts in ``points`` (M, 3) with part ``labels`` (M,), or (None, None) when
     ``model`` has fewer than two prismatic joints, neither the stacked parts together nor the target
     alone are flat and face along the slide ``direction`` (3,), or fewer than k + 1 handles are in
-    view. World frame, metres."""
+    view; with ``target_hint`` (3,), the task's target part's centre, the handle nearest its height.
+    World frame, metres."""
     stacked = [int(c) for c, t in zip(model.joint_child_parts, model.joint_types, strict=False)
                if t == "prismatic"]
     if len(stacked) < 2:
@@ -58,7 +62,9 @@ def stacked_handle(points: np.ndarray, handle_cloud: np.ndarray, min_points: int
         if not faces_along(plane, direction, config.face_max_angle):
             return None, None
     fewest = max(MIN_HANDLE_POINTS, int(min_points * config.handle_share))
-    handle = kth_handle_from_bottom(handle_cloud, front, k, plane=plane, min_points=fewest)
+    height = None if target_hint is None else float(target_hint[2])
+    handle = kth_handle_from_bottom(handle_cloud, front, k, plane=plane, min_points=fewest,
+                                    target_height=height)
     return (plane, handle) if handle is not None else (None, None)
 
 
@@ -76,7 +82,7 @@ class StackedParts:
             return False
         plane, handle = stacked_handle(draft.points, draft.handle_cloud, draft.handle_min_points,
                                        draft.labels, draft.model, draft.target, draft.direction,
-                                       self.config)
+                                       self.config, draft.target_hint)
         if handle is None:
             return False
         draft.use_plane(plane)
