@@ -36,7 +36,7 @@ class Draft:
     (``joint_child_parts``, ``joint_types``), ``target`` the joint's index, ``dense_points`` (D, 3)
     all isolated object points (or None), ``viewpoint`` (3,) the cameras' mean position (or None),
     ``target_hint`` (3,) the target part's centre of mass as the task gives it (or None): it only
-    chooses between alike parts (a double door's leaves), never sets the estimate.
+    chooses between alike parts (a double door's leaves, a stack's drawers), never sets the estimate.
 
     Working geometry (refiners may replace it): ``handle_cloud`` the points handles are looked for
     among and ``handle_min_points`` the fewest points of a handle there; ``panel`` the flat panel the
