@@ -205,8 +205,13 @@ def opening_direction(joint_type: str, direction: np.ndarray, pivot: np.ndarray,
     return -u if float(motion @ outward) < 0.0 else u
 
 
+LEAF_MIN_APART = 0.06
+"""m: two like handles at least this far apart on one flat panel are on two leaves of a double door
+(one handle's cluster spans less)."""
+
+
 def double_door_seam(grasp: np.ndarray, other_handles: Sequence[np.ndarray], centre: np.ndarray,
-                     across: np.ndarray, along: np.ndarray, min_apart: float = 0.06,
+                     across: np.ndarray, along: np.ndarray, min_apart: float = LEAF_MIN_APART,
                      max_height: float = 0.1, beside_slope: float = 0.75) -> float | None:
     """Where (m across, unit ``across`` (3,) from ``centre`` (3,)) two doors meet, when one of
     ``other_handles`` (each (3,)) stands beside the ``grasp`` (3,) handle: at least ``min_apart`` m

@@ -40,7 +40,7 @@ import numpy as np
 from capt_common.typed_yaml import require
 from capt_env.wrappers.estimate import unit
 from capt_env.wrappers.grasp_candidates import GraspCandidate, GraspCandidateConfig, find_grasp_candidates
-from capt_env.wrappers.moving_part_geometry import PartPlane
+from capt_env.wrappers.moving_part_geometry import LEAF_MIN_APART, PartPlane
 from capt_env.wrappers.refiners.draft import Draft
 
 
@@ -126,11 +126,6 @@ def twin(other: GraspCandidate, handle: GraspCandidate) -> bool:
     if other.kind != handle.kind:
         return False
     return other.kind != "bar" or abs(float(other.bar_axis @ handle.bar_axis)) >= np.cos(TWIN_BAR_ANGLE)
-
-
-LEAF_MIN_APART = 0.06
-"""m: two twin handles at least this far apart in the face's plane are on two leaves (the
-``min_apart`` of :func:`~capt_env.wrappers.moving_part_geometry.double_door_seam`)."""
 
 
 def target_leaf_handle(handles: list[GraspCandidate], face: PartPlane, target_hint: np.ndarray | None,
