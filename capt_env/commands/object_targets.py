@@ -86,8 +86,10 @@ def add_object_arguments(parser: argparse.ArgumentParser, categories_default: li
                          with_categories: bool = True) -> None:
     """``--categories`` (unless the verb has its own category flag) plus the user-file options."""
     if with_categories:
-        parser.add_argument("--categories", nargs="*", default=categories_default,
-                            help="procedural object categories (none when only user files are given)")
+        parser.add_argument("--categories", nargs="*", default=None,
+                            help=f"procedural object categories (default: {categories_default} without "
+                                 "user files, none with them)")
+        parser.set_defaults(categories_default=categories_default)
     parser.add_argument("--object", action="append", default=[], metavar="PATH",
                         help="a user URDF/MJCF file (repeatable); evaluated beside any categories given")
     parser.add_argument("--objects", default=None, metavar="FILE.yaml",
@@ -151,7 +153,11 @@ def object_targets(args: argparse.Namespace) -> list[ObjectTarget]:
     from capt_env.objects.registry import CATEGORIES
 
     targets = []
-    for category in args.categories or []:
+    categories = args.categories
+    if categories is None:  # the verb's default categories stand in only when no user file is given
+        user_files = bool(args.object or args.objects)
+        categories = [] if user_files else list(getattr(args, "categories_default", None) or [])
+    for category in categories:
         if category not in CATEGORIES:
             raise SystemExit(f"unknown category {category!r}; known: {list(CATEGORIES)}")
         targets.append(ObjectTarget(label=category, category=category))

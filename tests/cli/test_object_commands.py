@@ -109,3 +109,16 @@ def test_inspect_object_says_which_handle_search_finds_a_grip() -> None:
     assert handle_search_note(0.05) == ""  # within the first band
     assert "found only when nothing stands in that band" in handle_search_note(0.10)  # a bar on long posts
     assert "may fall back" in handle_search_note(0.15)  # beyond both
+
+
+@pytest.mark.parametrize("verb", ["rollout", "estimate-errors"])
+def test_user_files_alone_evaluate_no_default_category(verb: str, drawer_urdf: Path) -> None:
+    from capt_env.cli import build_parser
+    from capt_env.commands.object_targets import object_targets
+
+    parser = build_parser()
+    alone = object_targets(parser.parse_args([verb, "--object", str(drawer_urdf)]))
+    assert [t.label for t in alone] == ["small_drawer"]
+    beside = object_targets(parser.parse_args([verb, "--categories", "laptop", "--object", str(drawer_urdf)]))
+    assert [t.label for t in beside] == ["laptop", "small_drawer"]
+    assert [t.label for t in object_targets(parser.parse_args([verb]))] == ["cabinet_door"]
