@@ -2,8 +2,9 @@
 
 Prints the movable joints (type, limits, which limit is closed), each link's size and mass, the
 front the task turns to the robot, the placement, the grasp target (and how far a handle stands off
-the part's face, against the band CAPT's handle search looks in) and whether the Panda can reach it
-closed and opened to the success fraction; writes a PNG of the object seen from the task's first
+the part's face, against the band CAPT's handle search looks in), whether the Panda can reach it
+closed and opened to the success fraction and whether each task camera sees it (a handle outside
+every camera's picture cannot be perceived); writes a PNG of the object seen from the task's first
 camera with the target joint's axis drawn (red, arrow at the end that opens).
 """
 
@@ -17,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from capt_common.json_report import write_json
+from capt_env.tasks.camera_view import pixels
 
 PANDA_SHOULDER_HEIGHT = 0.333
 """m: height of the Panda's second joint above its base (the centre of its reach sphere)."""
@@ -53,13 +55,6 @@ def _link_rows(env: Any) -> list[dict[str, Any]]:
     return rows
 
 
-def _project(points: np.ndarray, intrinsic: np.ndarray, extrinsic: np.ndarray) -> np.ndarray:
-    """Pixel (u, v) of world points through an OpenCV camera (extrinsic: world -> camera, 3x4)."""
-    cam = points @ extrinsic[:3, :3].T + extrinsic[:3, 3]
-    uvw = cam @ intrinsic.T
-    return uvw[:, :2] / np.maximum(uvw[:, 2:3], 1e-6)
-
-
 def _picture(path: Path, env: Any, axis: np.ndarray, pivot: np.ndarray, grasp: np.ndarray,
              title: str) -> Path:
     """The first camera's RGB with the axis (world, 0.5 m long) and the grasp point drawn."""
@@ -74,7 +69,7 @@ def _picture(path: Path, env: Any, axis: np.ndarray, pivot: np.ndarray, grasp: n
     params = obs["sensor_param"][cam]
     k = params["intrinsic_cv"][0].cpu().numpy()
     ext = params["extrinsic_cv"][0].cpu().numpy()
-    ends = _project(np.stack([pivot - 0.25 * axis, pivot + 0.25 * axis, grasp]), k, ext)
+    ends = pixels(np.stack([pivot - 0.25 * axis, pivot + 0.25 * axis, grasp]), k, ext)
     fig, ax = plt.subplots(figsize=(5, 5))
     ax.imshow(rgb)
     ax.annotate("", xy=ends[1], xytext=ends[0], arrowprops={"arrowstyle": "->", "color": "red", "lw": 2})
@@ -149,6 +144,8 @@ def run(args: argparse.Namespace) -> int:
                                                    dtype=torch.float32).reshape(1, -1))
         reach = {"closed_m": _reach(grasp_closed), "opened_m": _reach(grasp_open), "limit_m": PANDA_REACH}
         reach["ok"] = reach["closed_m"] <= PANDA_REACH and reach["opened_m"] <= PANDA_REACH
+        cameras = [{"camera": v.camera, "sees_grasp_point": bool(v.seen[0]),
+                    "step_back_m": round(float(v.step_back_m[0]), 3)} for v in base.grasp_point_views()]
         front_azimuth = math.pi - obj.front_yaw
         report = {
             "path": str(path), "joints": joints, "links": _link_rows(env),
@@ -159,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
             "placement_shift_m": [round(float(d), 4) for d in obj.placement_shift],
             "grasp_point_m": grasp_closed.tolist(),
             "grasp_from": obj.grasp_source, "grasp_standoff_m": obj.grasp_standoff,
-            "reach": reach, "warnings": list(obj.warnings),
+            "reach": reach, "cameras": cameras, "warnings": list(obj.warnings),
         }
         png = Path(args.png or f"{path.stem}_inspect.png")
         report["png"] = str(_picture(png, env, axis, pivot, grasp_closed,
@@ -191,6 +188,11 @@ def run(args: argparse.Namespace) -> int:
     print(f"reach from the Panda's shoulder: closed {reach['closed_m']:.2f} m, opened to "
           f"{base.task_config.success_fraction:.0%} {reach['opened_m']:.2f} m "
           f"(limit {PANDA_REACH} m): {verdict}")
+    for cam in cameras:
+        seen = ("sees the grasp target" if cam["sees_grasp_point"] else
+                f"DOES NOT SEE the grasp target: move it {cam['step_back_m']:.2f} m back along its line of "
+                "sight (the task's cameras: eye)")
+        print(f"camera {cam['camera']}: {seen}")
     for warning in report["warnings"]:
         print(f"warning: {warning}")
     print(f"picture: {report['png']}")

@@ -45,6 +45,7 @@ the object.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -63,6 +64,7 @@ from mani_skill.utils.structs import Articulation, Pose
 from capt_common.typed_yaml import from_dict
 from capt_env.registration import GENERIC_ID
 from capt_env.rendering import translate_render_error
+from capt_env.tasks.camera_view import in_picture, step_back_to_see
 from capt_env.tasks.config import (
     RESTING_ARM_BOTTOM_Z,
     RESTING_ARM_CLEARANCE,
@@ -79,6 +81,20 @@ JOINT_TYPE_IDS = {"revolute": 0, "prismatic": 1}
 # applies the rotation part with a negative scale: a +1 rotation action turns by -0.1 rad).
 DEFAULT_CONTROL_MODE = "pd_ee_delta_pose"
 ROBOT_BASE_XY = (-0.615, 0.0)
+
+
+class UnseenGraspPointWarning(UserWarning):
+    """A reset left the target part's grasp point outside every task camera's picture."""
+
+
+@dataclass(frozen=True)
+class GraspPointView:
+    """One camera's view of the grasp points: ``seen`` (num_envs,) bool, ``step_back_m`` (num_envs,)
+    how far it must move back along its line of sight to see each (0 where it does)."""
+
+    camera: str
+    seen: np.ndarray
+    step_back_m: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -166,6 +182,7 @@ class OpenArticulatedEnv(BaseEnv):
         self._entropy_seed_pending = False
         self.sensors_on_next_obs = True  # see get_obs
         self._held_obs: dict[bool | None, Any] = {}
+        self._warned_unseen_grasp = False  # the constructor's own reset may warn first
         with translate_render_error():
             super().__init__(
                 *args,
@@ -185,7 +202,9 @@ class OpenArticulatedEnv(BaseEnv):
             # Gymnasium's own generator (env.np_random), seeded like ManiSkill's episode RNGs.
             first = int(seed[0]) if isinstance(seed, (list, tuple, np.ndarray)) else int(seed)
             self._np_random, self._np_random_seed = gym_seeding.np_random(first)
-        return super().reset(seed=seed, options=options)
+        obs, info = super().reset(seed=seed, options=options)
+        self._warn_if_no_camera_sees_the_grasp_point()
+        return obs, info
 
     # ------------------------------------------------------------------ scene
     @property
@@ -335,6 +354,41 @@ class OpenArticulatedEnv(BaseEnv):
         joint or handle is."""
         link = self.object_batch.target_link
         return (link.pose * link.cmass_local_pose).p
+
+    def grasp_point_views(self) -> list[GraspPointView]:
+        """For each camera, whether each sub-scene's grasp point (:meth:`grasp_point`) is inside its
+        picture and how far (m) it must move back along its line of sight for it to be
+        (:mod:`capt_env.tasks.camera_view`). A handle no camera sees cannot be perceived."""
+        grasp = self.grasp_point().cpu().numpy().astype(np.float64)
+        views = []
+        for name, sensor in self._sensors.items():
+            k = sensor.camera.get_intrinsic_matrix().cpu().numpy()
+            ext = sensor.camera.get_extrinsic_matrix().cpu().numpy()
+            w, h = sensor.config.width, sensor.config.height
+            seen = np.array([bool(in_picture(g[None], k[i], ext[i], w, h)[0]) for i, g in enumerate(grasp)])
+            back = np.array([step_back_to_see(g[None], k[i], ext[i], w, h) for i, g in enumerate(grasp)])
+            views.append(GraspPointView(name, seen, back))
+        return views
+
+    def _warn_if_no_camera_sees_the_grasp_point(self) -> None:
+        """Warn once per env when a reset leaves some sub-scene's grasp point outside every camera's
+        picture (a large object seen from the default eyes): perception cannot find that handle."""
+        if self._warned_unseen_grasp or not self._sensors:
+            return
+        views = self.grasp_point_views()
+        grasp = self.grasp_point().cpu().numpy().astype(np.float64)
+        unseen = ~np.any([v.seen for v in views], axis=0)
+        if not unseen.any():
+            return
+        self._warned_unseen_grasp = True
+        i = int(np.flatnonzero(unseen)[0])
+        what = self.task_config.object or self.task_config.category
+        moves = ", ".join(f"{v.camera} by {v.step_back_m[i]:.2f} m" for v in views)
+        warnings.warn(f"{what}: no camera sees the target part's grasp point "
+                      f"{np.round(grasp[i], 3).tolist()} (world, m), so a "
+                      f"perceived estimate cannot find its handle; a camera sees it moved back along its "
+                      f"line of sight ({moves}; the task's cameras: eye)", UnseenGraspPointWarning,
+                      stacklevel=3)
 
     def evaluate(self) -> dict[str, torch.Tensor]:
         cfg = self.task_config
