@@ -9,7 +9,9 @@ target is computed from the same look (one render and one network run per reset)
 only by the refiners.
 Errors per reset: the signed direction error (degrees; a flipped axis counts as ~180), the
 distance between the estimated and true axis lines (revolute joints only, metres), the state error
-(radians or metres) and the grasp point's distance to the true one (metres).
+(radians or metres), the grasp point's distance to the true one (metres) and whether any camera
+had the true grasp point in its picture (a handle no camera sees cannot be found; see
+``OpenArticulatedEnv.grasp_point_views``).
 """
 
 from __future__ import annotations
@@ -74,6 +76,7 @@ def _summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
             "state_error_median": float(np.median(state)),
             "grasp_m_mean": float(np.mean([r["grasp_m"] for r in rows])),
             "grasp_far": float(np.mean([r["grasp_m"] > 0.1 for r in rows])),
+            "grasp_seen": float(np.mean([r["grasp_seen"] for r in rows])),
             "type_right": float(np.mean([r["type_right"] for r in rows]))}
 
 
@@ -127,8 +130,8 @@ def run(args: argparse.Namespace) -> int:
     task = task_overrides(args.task)
     header = ("| object | perception | refiners | direction (deg, mean) | direction (deg, median) | "
               "sign right | line (cm, mean) | line (cm, median) | state (mean) | grasp point (cm) | "
-              "grasp > 10 cm | resets |")
-    table, results = [header, "|" + " --- |" * 12], []
+              "grasp > 10 cm | grasp point in view | resets |")
+    table, results = [header, "|" + " --- |" * 13], []
     for target in object_targets(args):
         like = target.model_category()
         checkpoint = str(args.checkpoint or default_checkpoint(like))
@@ -143,12 +146,15 @@ def run(args: argparse.Namespace) -> int:
                 _, info = env.reset(seed=seed)
                 truth = ground_truth_estimate(info)
                 joint_type = truth.joint_type
+                # a handle no camera sees cannot be perceived: said beside the grasp point's error
+                in_view = any(bool(v.seen[0]) for v in env.unwrapped.grasp_point_views())
                 seen = env.source.last_look
                 for (source, left_out), rows in zip(rows_of, per_row, strict=True):
                     pipeline = _pipeline(source, left_out)
                     est = env.estimate if seen is None else pipeline.estimate(seen)  # None: too few points
                     fired = [] if pipeline.last_draft is None else list(pipeline.last_draft.fired)
-                    rows.append({"seed": seed, **estimate_errors(est, truth), "fired": fired})
+                    rows.append({"seed": seed, **estimate_errors(est, truth), "grasp_seen": in_view,
+                                 "fired": fired})
         finally:
             env.close()
         for (source, left_out), rows in zip(rows_of, per_row, strict=True):
@@ -161,7 +167,7 @@ def run(args: argparse.Namespace) -> int:
                          f"{s['direction_deg_mean']:.1f} | {s['direction_deg_median']:.1f} | "
                          f"{s['sign_right']:.2f} | {_cm(s['line_m_mean'])} | {_cm(s['line_m_median'])} | "
                          f"{_state_cell(s, joint_type)} | {100 * s['grasp_m_mean']:.1f} | "
-                         f"{s['grasp_far']:.2f} | {s['resets']} |")
+                         f"{s['grasp_far']:.2f} | {s['grasp_seen']:.2f} | {s['resets']} |")
     text = "\n".join(table)
     print(text)
     if args.markdown:

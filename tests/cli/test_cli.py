@@ -151,7 +151,7 @@ def test_estimate_errors_hinge_on_door_edge_beats_capt_line(tmp_path: Path) -> N
     """Two unseen cabinet doors, each looked at once and scored raw, refined and refined without
     ``hinge_on_edge``: on the door's edge the hinge line is within 5 cm and at most half as far off as
     without it (the network's own line: 1.6 and 6.5 cm; on the edge 2.8 and 0.1 cm), and every row
-    names its perception source."""
+    names its perception source and whether a camera saw the grasp point."""
     out, table = tmp_path / "errors.json", tmp_path / "errors.md"
     repo = Path(__file__).resolve().parents[2]
     assert main(["estimate-errors", "--categories", "cabinet_door", "--episodes", "2", "--task",
@@ -166,6 +166,8 @@ def test_estimate_errors_hinge_on_door_edge_beats_capt_line(tmp_path: Path) -> N
     assert any("hinge_on_edge" in r["fired"] for r in refined["per_reset"])
     assert all(r["fired"] == [] for r in raw["per_reset"])
     assert "| capt_raw | none |" in table.read_text() and "| capt | all |" in table.read_text()
+    assert refined["grasp_seen"] == 1.0 and all(r["grasp_seen"] for r in refined["per_reset"])
+    assert "grasp point in view" in table.read_text()
 
 
 def test_train_config_takes_the_command_line_overrides(tmp_path: Path) -> None:
