@@ -4,7 +4,7 @@ A task camera looks at the object's bounding-box centre from a fixed offset
 (:class:`~capt_env.tasks.config.CameraConfig`). On a large or deep object (a kitchen cabinet 0.9 m
 wide with its handle at the front corner) the part's handle can fall outside every camera's
 picture; perception then cannot find it whatever the network, so the task says so (see
-``OpenArticulatedEnv.cameras_seeing_grasp``). Cameras follow OpenCV's convention, as ManiSkill's
+``OpenArticulatedEnv.grasp_point_views``). Cameras follow OpenCV's convention, as ManiSkill's
 ``intrinsic_cv`` / ``extrinsic_cv`` give them: camera frame x right, y down, z forward; metres.
 """
 

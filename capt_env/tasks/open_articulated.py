@@ -36,6 +36,9 @@ a joint: sub-scenes whose instances have fewer joints than the batch's most are 
 ``open_fraction``, ``grasp_point``, ``target_link_pos`` (the target part's centre of mass, metres:
 which part the task means, as ManiSkill's TurnFaucet gives it; not where its joint or handle is),
 ``success``.
+The cameras look at the object's bounding-box centre from fixed offsets; a reset that leaves the
+grasp point outside every camera's picture (a large object) warns once per env
+(:class:`UnseenGraspPointWarning`; :meth:`OpenArticulatedEnv.grasp_point_views`).
 In ``pointcloud`` mode the observation's ``pointcloud`` dict also carries ``part_label``: for each
 point the object part it lies on (0 = everything fixed to the base, ``k + 1`` = the part movable
 joint ``k`` moves, links joined by fixed joints counted as one part), or -1 for anything that is not
