@@ -56,13 +56,18 @@ def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     links, joints, grasp = [body], [], (0.0, 0.0, 0.0)
     y0, y1 = -width / 2 + wall + GAP, width / 2 - wall - GAP
     inner_depth = depth_frac * (depth - wall - front_t)
+    fill = 1.0 if style is None else style.front_fill
     for i in range(count):
         z0 = wall + i * slot + GAP
         z1 = wall + (i + 1) * slot - GAP
+        zc = (z0 + z1) / 2  # the joint's line: through the opening's middle whatever the front
+        zf, zh = z1, zc  # the front's top and its handle's height
+        if fill < 1.0:  # ``openings``: a lower front, the carcass's inside showing above it
+            zf = z0 + fill * (z1 - z0)
+            zh = (z0 + zf) / 2
         xb = xf + front_t + inner_depth  # back of the drawer box
-        zt = z0 + box_frac * (z1 - z0)
-        zc = (z0 + z1) / 2
-        front = build_front(Front((xf, y0, z0), (xf + front_t, y1, z1), 0, -1.0, front_color, (xf, 0.0, zc),
+        zt = z0 + box_frac * (zf - z0)
+        front = build_front(Front((xf, y0, z0), (xf + front_t, y1, zf), 0, -1.0, front_color, (xf, 0.0, zh),
                                   along=1, handle_length=handle_len * (y1 - y0), handle_thickness=handle_t,
                                   standoff=standoff, handle_color=handle_color, default_handle=handle_style),
                             style)

@@ -25,6 +25,9 @@ _STYLE_STREAM = 7_411  # keeps the style generator apart from the shape paramete
 LEVER_MAX_STANDOFF = 0.13
 """Metres: the longest stem a varied lever stands on, off its panel's face (door levers and the
 simulators' door files stand 6-13 cm off; cabinet bars 3-4.5 cm)."""
+FRONT_FILL = (0.6, 0.9)
+"""The share of its opening's height a drawer's front fills under ``openings`` (Meta-World's drawer:
+its 10.4 cm front in a 16.8 cm opening, 0.62)."""
 
 
 @dataclass(frozen=True)
@@ -48,16 +51,21 @@ class GeometryVariation:
       shelves and a divider in a cabinet, one or two wire racks in an oven, a drum of slats in a
       washing machine, frames between the drawers of a drawer cabinet and a divider in each drawer
       (that one moves with its drawer).
+    - ``openings``: a drawer's front is lower than its opening (60-90 % of it, standing at the
+      opening's foot, the drawer's box no taller than its front), so the carcass's inside shows
+      above a closed drawer, as on a drawer whose front is its box's own wall (Meta-World's). The
+      joint, its limits and the opening are unchanged; other categories ignore it.
     """
 
     panels: bool = False
     handles: bool = False
     interiors: bool = False
+    openings: bool = False
 
     @property
     def enabled(self) -> bool:
         """True when any option is on."""
-        return self.panels or self.handles or self.interiors
+        return self.panels or self.handles or self.interiors or self.openings
 
 
 @dataclass(frozen=True)
@@ -67,7 +75,7 @@ class Style:
     ``handle_angle`` (radians) turns bars and levers in the panel plane from the category's bar
     direction; ``lever_stem`` in [0, 1) places a lever's stem between the category's standoff and
     :data:`LEVER_MAX_STANDOFF` (:func:`lever_standoff`); ``seed`` draws the interior's details
-    (:meth:`rng`)."""
+    (:meth:`rng`); ``front_fill`` is the share of its opening's height a drawer's front fills."""
 
     panel: PanelShape = "box"
     panel_size: float = 0.0
@@ -77,6 +85,7 @@ class Style:
     interior: bool = False
     seed: int = 0
     lever_stem: float = 0.0
+    front_fill: float = 1.0
 
     def rng(self) -> np.random.Generator:
         """A fresh generator for the interior's details (the same every call)."""
@@ -97,7 +106,8 @@ def draw_style(category: str, instance_id: int, variation: GeometryVariation) ->
     turned = float(rng.uniform(-math.pi / 2, math.pi / 2))
     angle = float(rng.choice([0.0, math.pi / 2])) if aligned else turned
     seed = int(rng.integers(2**31))
-    lever_stem = float(rng.random())  # drawn last: the draws above are those of styles before it
+    lever_stem = float(rng.random())  # drawn after the others: the draws above are those of styles before it
+    fill = float(rng.uniform(*FRONT_FILL))  # drawn last, for the same reason
     return Style(
         panel=panel if variation.panels else "box",
         panel_size=size,
@@ -107,6 +117,7 @@ def draw_style(category: str, instance_id: int, variation: GeometryVariation) ->
         interior=variation.interiors,
         seed=seed,
         lever_stem=lever_stem if variation.handles else 0.0,
+        front_fill=fill if variation.openings else 1.0,
     )
 
 

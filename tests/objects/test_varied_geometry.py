@@ -140,3 +140,25 @@ def test_side_door_levers_stand_off_as_far_as_door_levers_do_and_others_stay_sho
             assert reach.max() - reach.min() > 0.04, (category, reach)
         else:
             np.testing.assert_allclose(reach, 0.0, atol=1e-6, err_msg=category)
+
+
+def test_openings_lower_a_drawer_front_below_its_opening_and_keep_the_joint() -> None:
+    openings = GeometryVariation(openings=True)
+    fills = []
+    for i in range(0, 1000, 41):
+        plain, varied = make_object("drawer_cabinet", i), make_object("drawer_cabinet", i, openings)
+        style = draw_style("drawer_cabinet", i, openings)
+        fills.append(style.front_fill)
+        assert varied.joints == plain.joints and varied.params == plain.params
+        assert plain.links[0] == varied.links[0]  # the carcass and its openings as they were
+        for a, b in zip(plain.links[1:], varied.links[1:], strict=True):
+            top_plain = max(bx.pos[2] + bx.half_size[2] for bx in a.boxes)
+            top_varied = max(bx.pos[2] + bx.half_size[2] for bx in b.boxes)
+            low_plain = min(bx.pos[2] - bx.half_size[2] for bx in a.boxes)
+            assert top_varied < top_plain - 0.005  # a gap above the front, into the carcass
+            height = top_plain - low_plain
+            assert 0.55 * height < top_varied - low_plain < 0.95 * height
+        link = varied.links[varied.link_index(varied.grasp_link)]
+        assert any(bx.is_handle and _inside(np.asarray(varied.grasp_point), bx) for bx in link.boxes)
+    assert 0.6 <= min(fills) and max(fills) <= 0.9 and max(fills) - min(fills) > 0.15
+    assert make_object("oven", 3, openings) == make_object("oven", 3)  # other categories ignore it
