@@ -40,6 +40,7 @@ import math
 import multiprocessing as mp
 import os
 import tempfile
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -87,6 +88,7 @@ def _env_for(cfg: GenerateConfig) -> Any:
         import gymnasium as gym
 
         import capt_env
+        from capt_env.tasks.open_articulated import UnseenGraspPointWarning
 
         if _ENV is not None:
             _ENV.close()
@@ -100,13 +102,18 @@ def _env_for(cfg: GenerateConfig) -> Any:
         }
         if cfg.variation.viewpoints.mode == "robot":
             del task["object_xy"]  # where the task puts the object: robot-centric views
-        if cfg.variation.needs_scene:
-            from capt_env.dataset.scene_env import make_generate_env
+        # a random view that misses the handle is a training sample, not a task that cannot be
+        # perceived: the task's unseen-grasp warning is not for datasets
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UnseenGraspPointWarning)
+            if cfg.variation.needs_scene:
+                from capt_env.dataset.scene_env import make_generate_env
 
-            _ENV = make_generate_env(task, cfg.variation)
-        else:
-            _ENV = gym.make(capt_env.registration.GENERIC_ID, obs_mode="pointcloud", task=task,
-                            reconfiguration_freq=0)
+                _ENV = make_generate_env(task, cfg.variation)
+            else:
+                _ENV = gym.make(capt_env.registration.GENERIC_ID, obs_mode="pointcloud", task=task,
+                                reconfiguration_freq=0)
+        _ENV.unwrapped.warn_unseen_grasp_point = False
         _ENV_KEY = key
     return _ENV
 

@@ -185,6 +185,7 @@ class OpenArticulatedEnv(BaseEnv):
         self._entropy_seed_pending = False
         self.sensors_on_next_obs = True  # see get_obs
         self._held_obs: dict[bool | None, Any] = {}
+        self.warn_unseen_grasp_point = True  # see _warn_if_no_camera_sees_the_grasp_point
         self._warned_unseen_grasp = False  # the constructor's own reset may warn first
         with translate_render_error():
             super().__init__(
@@ -375,8 +376,10 @@ class OpenArticulatedEnv(BaseEnv):
 
     def _warn_if_no_camera_sees_the_grasp_point(self) -> None:
         """Warn once per env when a reset leaves some sub-scene's grasp point outside every camera's
-        picture (a large object seen from the default eyes): perception cannot find that handle."""
-        if self._warned_unseen_grasp or not self._sensors:
+        picture (a large object seen from the default eyes): perception cannot find that handle.
+        ``warn_unseen_grasp_point = False`` silences it (dataset generation: a random view that
+        misses the handle is a training sample like any other)."""
+        if self._warned_unseen_grasp or not self.warn_unseen_grasp_point or not self._sensors:
             return
         views = self.grasp_point_views()
         grasp = self.grasp_point().cpu().numpy().astype(np.float64)

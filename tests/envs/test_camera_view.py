@@ -70,3 +70,21 @@ def test_the_default_cameras_see_a_procedural_part_s_grasp_point() -> None:
         finally:
             env.close()
     assert not [w for w in caught if issubclass(w.category, UnseenGraspPointWarning)]
+
+
+def test_the_unseen_grasp_warning_can_be_turned_off() -> None:
+    # dataset generation turns it off: a random view that misses the handle is a training sample
+    narrow = {"name": "narrow", "eye": [-0.45, -0.35, 0.45], "width": 32, "height": 32, "fov": 0.1}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnseenGraspPointWarning)
+        env = gym.make(env_id("laptop"), obs_mode="state", task={"cameras": [narrow], "split": "test"})
+    try:
+        base = env.unwrapped
+        for on in (False, True):
+            base.warn_unseen_grasp_point, base._warned_unseen_grasp = on, False  # re-armed
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                env.reset(seed=0)
+            assert len([w for w in caught if issubclass(w.category, UnseenGraspPointWarning)]) == int(on)
+    finally:
+        env.close()
