@@ -158,6 +158,12 @@ JOINT_KEYS = ("joint_types", "joint_dirs", "joint_pivots", "joint_states", "join
 """The stacked arrays with a joint axis (axis 1)."""
 
 
+def empty_slot_value(key: str) -> int:
+    """What a slot without a joint holds in ``key`` (one of :data:`JOINT_KEYS`): -1 for its type and
+    child part, 0 elsewhere."""
+    return -1 if key in ("joint_types", "joint_child_part") else 0
+
+
 TARGET_ONLY_KEY = "target_only"
 """(S,) bool: the sample was cut to its target joint by :func:`target_joint_only`."""
 
@@ -180,7 +186,7 @@ def target_joint_only(a: dict[str, np.ndarray], num_joints: int) -> dict[str, np
         slot = min(t, num_joints - 1)
         for k in JOINT_KEYS:
             row = out[k][i]
-            row[:] = -1 if k in ("joint_types", "joint_child_part") else 0
+            row[:] = empty_slot_value(k)
             row[slot] = a[k][i, t]
         out["joint_child_part"][i, slot] = slot + 1
         labels = a["part_labels"][i]
@@ -201,8 +207,7 @@ def fit_joint_slots(a: dict[str, np.ndarray], num_joints: int) -> dict[str, np.n
     for k in JOINT_KEYS:
         v = a[k][:, :num_joints]
         if j < num_joints:
-            fill = -1 if k in ("joint_types", "joint_child_part") else 0
-            pad = np.full((v.shape[0], num_joints - j, *v.shape[2:]), fill, dtype=v.dtype)
+            pad = np.full((v.shape[0], num_joints - j, *v.shape[2:]), empty_slot_value(k), dtype=v.dtype)
             v = np.concatenate([v, pad], axis=1)
         out[k] = v
     return out

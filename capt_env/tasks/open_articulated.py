@@ -382,10 +382,10 @@ class OpenArticulatedEnv(BaseEnv):
         if self._warned_unseen_grasp or not self.warn_unseen_grasp_point or not self._sensors:
             return
         views = self.grasp_point_views()
-        grasp = self.grasp_point().cpu().numpy().astype(np.float64)
         unseen = ~np.any([v.seen for v in views], axis=0)
         if not unseen.any():
             return
+        grasp = self.grasp_point().cpu().numpy().astype(np.float64)
         self._warned_unseen_grasp = True
         i = int(np.flatnonzero(unseen)[0])
         what = self.task_config.object or self.task_config.category
