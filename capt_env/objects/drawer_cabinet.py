@@ -19,20 +19,40 @@ from capt_env.objects.style import Style
 
 CATEGORY = "drawer_cabinet"
 GAP = 0.002  # m, between drawer fronts and around them
+WIDTH = (0.30, 0.50)
+"""Metres: the carcass's width range; under ``proportions`` (``capt_env.objects.style``) it reaches
+down to :data:`NARROW`."""
+DEPTH = (0.28, 0.45)
+"""Metres: the carcass's depth range; under ``proportions`` it reaches down to :data:`SHALLOW`."""
+BOX_HEIGHT = (0.6, 0.8)
+"""A drawer box's height as a share of its front's; under ``proportions`` it reaches up to 1."""
+NARROW = 0.18
+SHALLOW = 0.16
+
+
+def proportions(width: float, depth: float, box_frac: float,
+                style: Style | None) -> tuple[float, float, float]:
+    """The carcass's width and depth (metres) and the drawer boxes' share of their fronts' height: the
+    category's own draws, or under ``proportions`` the style's places within the wider ranges."""
+    if style is None or style.proportions is None:
+        return width, depth, box_frac
+    u, v, w = style.proportions
+    return (NARROW + u * (WIDTH[1] - NARROW), SHALLOW + v * (DEPTH[1] - SHALLOW),
+            BOX_HEIGHT[0] + w * (1.0 - BOX_HEIGHT[0]))
 
 
 def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     """The drawer-cabinet instance ``instance_id`` (metres); ``style`` varies its fronts, handles and
-    interior (see ``capt_env.objects.style``)."""
+    interior and its proportions (see ``capt_env.objects.style``)."""
     s = ParamSampler(CATEGORY, instance_id)
     count = s.integer("num_drawers", 1, 3)
-    width = s.uniform("width", 0.30, 0.50)
-    depth = s.uniform("depth", 0.28, 0.45)
+    width = s.uniform("width", *WIDTH)
+    depth = s.uniform("depth", *DEPTH)
     slot = s.uniform("drawer_height", 0.10, 0.17)
     wall = s.uniform("wall", 0.012, 0.022)
     front_t = s.uniform("front_thickness", 0.012, 0.022)
     side_t = s.uniform("drawer_wall", 0.006, 0.012)
-    box_frac = s.uniform("drawer_box_height_frac", 0.6, 0.8)
+    box_frac = s.uniform("drawer_box_height_frac", *BOX_HEIGHT)
     depth_frac = s.uniform("drawer_depth_frac", 0.85, 0.95)
     travel = s.uniform("travel_frac", 0.7, 0.85)
     handle_style = s.choice("handle_style", ("bar", "knob"))
@@ -45,6 +65,8 @@ def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     inner_color = s.color("inner_color", WOODS)
     handle_color = s.color("handle_color", METALS)
 
+    width, depth, box_frac = proportions(width, depth, box_frac, style)  # after every draw, as they were
+    s.params.update(width=width, depth=depth, drawer_box_height_frac=box_frac)
     height = count * slot + 2 * wall
     xf = -depth / 2
     body_boxes = open_carcass(width, depth, height, wall, body_color)

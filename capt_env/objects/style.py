@@ -55,17 +55,24 @@ class GeometryVariation:
       opening's foot, the drawer's box no taller than its front), so the carcass's inside shows
       above a closed drawer, as on a drawer whose front is its box's own wall (Meta-World's). The
       joint, its limits and the opening are unchanged; other categories ignore it.
+    - ``proportions``: a drawer cabinet's proportions are drawn from ranges reaching beyond the
+      category's own (``capt_env.objects.drawer_cabinet``): its carcass 0.18-0.50 m wide (against
+      0.30-0.50) and 0.16-0.45 m deep (against 0.28-0.45), its drawers' boxes 60-100 % as tall as
+      their fronts (against 60-80 %), so narrow and shallow cabinets with full-height drawer boxes
+      appear, as Meta-World's drawer is (0.22 x 0.20 m, a box as tall as its front); the drawers,
+      their travel (a share of the depth) and handles follow the carcass. Other categories ignore it.
     """
 
     panels: bool = False
     handles: bool = False
     interiors: bool = False
     openings: bool = False
+    proportions: bool = False
 
     @property
     def enabled(self) -> bool:
         """True when any option is on."""
-        return self.panels or self.handles or self.interiors or self.openings
+        return self.panels or self.handles or self.interiors or self.openings or self.proportions
 
 
 @dataclass(frozen=True)
@@ -75,7 +82,9 @@ class Style:
     ``handle_angle`` (radians) turns bars and levers in the panel plane from the category's bar
     direction; ``lever_stem`` in [0, 1) places a lever's stem between the category's standoff and
     :data:`LEVER_MAX_STANDOFF` (:func:`lever_standoff`); ``seed`` draws the interior's details
-    (:meth:`rng`); ``front_fill`` is the share of its opening's height a drawer's front fills."""
+    (:meth:`rng`); ``front_fill`` is the share of its opening's height a drawer's front fills;
+    ``proportions`` (three numbers in [0, 1)) places a drawer cabinet's width, depth and drawer-box
+    height within the ``proportions`` ranges, None keeps the category's own draws."""
 
     panel: PanelShape = "box"
     panel_size: float = 0.0
@@ -86,6 +95,7 @@ class Style:
     seed: int = 0
     lever_stem: float = 0.0
     front_fill: float = 1.0
+    proportions: tuple[float, float, float] | None = None
 
     def rng(self) -> np.random.Generator:
         """A fresh generator for the interior's details (the same every call)."""
@@ -107,7 +117,8 @@ def draw_style(category: str, instance_id: int, variation: GeometryVariation) ->
     angle = float(rng.choice([0.0, math.pi / 2])) if aligned else turned
     seed = int(rng.integers(2**31))
     lever_stem = float(rng.random())  # drawn after the others: the draws above are those of styles before it
-    fill = float(rng.uniform(*FRONT_FILL))  # drawn last, for the same reason
+    fill = float(rng.uniform(*FRONT_FILL))  # drawn after the others, for the same reason
+    proportions = (float(rng.random()), float(rng.random()), float(rng.random()))  # drawn last, likewise
     return Style(
         panel=panel if variation.panels else "box",
         panel_size=size,
@@ -118,6 +129,7 @@ def draw_style(category: str, instance_id: int, variation: GeometryVariation) ->
         seed=seed,
         lever_stem=lever_stem if variation.handles else 0.0,
         front_fill=fill if variation.openings else 1.0,
+        proportions=proportions if variation.proportions else None,
     )
 
 

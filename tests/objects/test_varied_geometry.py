@@ -162,3 +162,45 @@ def test_openings_lower_a_drawer_front_below_its_opening_and_keep_the_joint() ->
         assert any(bx.is_handle and _inside(np.asarray(varied.grasp_point), bx) for bx in link.boxes)
     assert 0.6 <= min(fills) and max(fills) <= 0.9 and max(fills) - min(fills) > 0.15
     assert make_object("oven", 3, openings) == make_object("oven", 3)  # other categories ignore it
+
+
+def _extent(spec, axis: int) -> float:
+    lows = [bx.pos[axis] - bx.half_size[axis] for bx in spec.links[0].boxes]
+    highs = [bx.pos[axis] + bx.half_size[axis] for bx in spec.links[0].boxes]
+    return max(highs) - min(lows)
+
+
+def test_proportions_draw_narrow_shallow_drawer_cabinets_and_tall_drawer_boxes() -> None:
+    sizes = GeometryVariation(proportions=True)
+    widths, depths, box_fracs = [], [], []
+    for i in range(0, 1000, 37):
+        plain, varied = make_object("drawer_cabinet", i), make_object("drawer_cabinet", i, sizes)
+        width, depth = _extent(varied, 1), _extent(varied, 0)
+        assert varied.params["width"] == pytest.approx(width)
+        assert varied.params["depth"] == pytest.approx(depth)
+        widths.append(width)
+        depths.append(depth)
+        box_fracs.append(varied.params["drawer_box_height_frac"])
+        shared = set(plain.params) - {"width", "depth", "drawer_box_height_frac"}
+        assert {k: varied.params[k] for k in shared} == {k: plain.params[k] for k in shared}
+        assert _extent(varied, 2) == pytest.approx(_extent(plain, 2))  # the height is the drawers'
+        for joint, plain_joint in zip(varied.joints, plain.joints, strict=True):
+            # the travel is the same share of the (new) drawer depth
+            ratio = plain_joint.limits[1] / (plain.params["depth"] - plain.params["wall"]
+                                             - plain.params["front_thickness"])
+            assert joint.limits[1] == pytest.approx(
+                ratio * (depth - varied.params["wall"] - varied.params["front_thickness"]))
+            assert joint.limits[1] < depth
+        for link in varied.links[1:]:  # every drawer inside its carcass's width, its box as drawn
+            assert max(abs(bx.pos[1]) + bx.half_size[1] for bx in link.boxes) < width / 2
+            front, walls = link.boxes[0], [bx for bx in link.boxes[1:] if not bx.is_handle][:3]
+            low = front.pos[2] - front.half_size[2]
+            box_top = max(bx.pos[2] + bx.half_size[2] for bx in walls)
+            assert box_top - low == pytest.approx(
+                varied.params["drawer_box_height_frac"] * 2 * front.half_size[2], abs=1e-9)
+        link = varied.links[varied.link_index(varied.grasp_link)]
+        assert any(bx.is_handle and _inside(np.asarray(varied.grasp_point), bx) for bx in link.boxes)
+    assert min(widths) < 0.22 and max(widths) > 0.40 and min(depths) < 0.20 and max(depths) > 0.38
+    assert sum(w < 0.30 for w in widths) >= 5 and sum(d < 0.28 for d in depths) >= 5
+    assert min(box_fracs) >= 0.6 and max(box_fracs) > 0.9 and sum(f > 0.8 for f in box_fracs) >= 5
+    assert make_object("oven", 3, sizes) == make_object("oven", 3)  # other categories ignore it
