@@ -20,15 +20,35 @@ from capt_env.objects.style import Style
 
 CATEGORY = "cabinet_door"
 GAP = 0.002  # m, around the door
+WIDTH = (0.28, 0.48)
+"""Metres: the carcass's width range; under ``proportions`` (``capt_env.objects.style``) it is
+:data:`WIDE_WIDTH`, and likewise for the depth and the height."""
+DEPTH = (0.25, 0.40)
+HEIGHT = (0.32, 0.60)
+WIDE_WIDTH = (0.20, 0.75)
+WIDE_DEPTH = (0.15, 0.55)
+WIDE_HEIGHT = (0.22, 0.85)
+
+
+def proportions(width: float, depth: float, height: float,
+                style: Style | None) -> tuple[float, float, float]:
+    """The carcass's width, depth and height (metres): the category's own draws, or under
+    ``proportions`` the style's places within the wider ranges."""
+    if style is None or style.proportions is None:
+        return width, depth, height
+    u, v, w = style.proportions
+    return (WIDE_WIDTH[0] + u * (WIDE_WIDTH[1] - WIDE_WIDTH[0]),
+            WIDE_DEPTH[0] + v * (WIDE_DEPTH[1] - WIDE_DEPTH[0]),
+            WIDE_HEIGHT[0] + w * (WIDE_HEIGHT[1] - WIDE_HEIGHT[0]))
 
 
 def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     """The cabinet instance ``instance_id`` (metres, radians); ``style`` varies its door, handle and
     interior (see ``capt_env.objects.style``)."""
     s = ParamSampler(CATEGORY, instance_id)
-    width = s.uniform("width", 0.28, 0.48)
-    depth = s.uniform("depth", 0.25, 0.40)
-    height = s.uniform("height", 0.32, 0.60)
+    width = s.uniform("width", *WIDTH)
+    depth = s.uniform("depth", *DEPTH)
+    height = s.uniform("height", *HEIGHT)
     wall = s.uniform("wall", 0.012, 0.022)
     door_t = s.uniform("door_thickness", 0.012, 0.024)
     shelves = s.integer("shelves", 0, 1)
@@ -43,6 +63,8 @@ def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     body_color = s.color("body_color", WOODS + BODY_WHITES)
     door_color = s.color("door_color", WOODS + BODY_WHITES)
 
+    width, depth, height = proportions(width, depth, height, style)  # after every draw, as they were
+    s.params.update(width=width, depth=depth, height=height)
     xf = -depth / 2
     body = open_carcass(width, depth, height, wall, body_color)
     if shelves:

@@ -204,3 +204,22 @@ def test_proportions_draw_narrow_shallow_drawer_cabinets_and_tall_drawer_boxes()
     assert sum(w < 0.30 for w in widths) >= 5 and sum(d < 0.28 for d in depths) >= 5
     assert min(box_fracs) >= 0.6 and max(box_fracs) > 0.9 and sum(f > 0.8 for f in box_fracs) >= 5
     assert make_object("oven", 3, sizes) == make_object("oven", 3)  # other categories ignore it
+
+
+def test_proportions_draw_cabinet_doors_beyond_the_category_and_the_door_follows() -> None:
+    sizes = GeometryVariation(proportions=True)
+    extents = []
+    for i in range(0, 1000, 37):
+        plain, varied = make_object("cabinet_door", i), make_object("cabinet_door", i, sizes)
+        size = np.array([_extent(varied, 1), _extent(varied, 0), _extent(varied, 2)])  # width, depth, height
+        np.testing.assert_allclose(size, [varied.params[k] for k in ("width", "depth", "height")])
+        extents.append(size)
+        shared = set(plain.params) - {"width", "depth", "height"}
+        assert {k: varied.params[k] for k in shared} == {k: plain.params[k] for k in shared}
+        door = varied.links[varied.link_index("door")].boxes[0]  # the panel: the carcass's front
+        assert 2 * door.half_size[1] == pytest.approx(size[0] - 0.004)
+        assert 2 * door.half_size[2] == pytest.approx(size[2] - 0.004)
+        assert varied.joints[0].limits == plain.joints[0].limits
+        assert varied.joints[0].origin[0] == pytest.approx(-size[1] / 2)  # the hinge on the front
+    low, high = np.min(extents, axis=0), np.max(extents, axis=0)
+    assert np.all(low < [0.26, 0.22, 0.30]) and np.all(high > [0.55, 0.45, 0.70])
