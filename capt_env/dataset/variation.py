@@ -108,8 +108,9 @@ class SensorNoise:
 class Variation:
     """What varies beyond the instance, the joint states and the ring of viewpoints; each part is
     documented on its class: ``geometry`` (:class:`capt_env.objects.style.GeometryVariation`: panel
-    shapes, handles, interiors, drawer openings, drawer proportions; procedural categories only, a
-    user ``object`` file is rendered as it is), ``distractors``, ``viewpoints``, ``sensor_noise``."""
+    shapes, handles, interiors, drawer openings, drawer and door proportions; procedural categories
+    only, a user ``object`` file is rendered as it is), ``distractors``, ``viewpoints``,
+    ``sensor_noise``."""
 
     geometry: GeometryVariation = field(default_factory=GeometryVariation)
     distractors: Distractors = field(default_factory=Distractors)

@@ -87,7 +87,8 @@ class Style:
     :data:`LEVER_MAX_STANDOFF` (:func:`lever_standoff`); ``seed`` draws the interior's details
     (:meth:`rng`); ``front_fill`` is the share of its opening's height a drawer's front fills;
     ``proportions`` (three numbers in [0, 1)) places a drawer cabinet's width, depth and drawer-box
-    height within the ``proportions`` ranges, None keeps the category's own draws."""
+    height, or a cabinet door's width, depth and height, within the ``proportions`` ranges; None
+    keeps the category's own draws."""
 
     panel: PanelShape = "box"
     panel_size: float = 0.0
