@@ -16,7 +16,7 @@ from capt_env.objects.interiors import cabinet_interior
 from capt_env.objects.parts import BODY_WHITES, WOODS, box_from_bounds, open_carcass
 from capt_env.objects.sampling import ParamSampler
 from capt_env.objects.spec import JointSpec, LinkSpec, ObjectSpec, hinged_door_object
-from capt_env.objects.style import Style
+from capt_env.objects.style import Style, proportioned
 
 CATEGORY = "cabinet_door"
 GAP = 0.002  # m, around the door
@@ -28,18 +28,6 @@ HEIGHT = (0.32, 0.60)
 WIDE_WIDTH = (0.20, 0.75)
 WIDE_DEPTH = (0.15, 0.55)
 WIDE_HEIGHT = (0.22, 0.85)
-
-
-def proportions(width: float, depth: float, height: float,
-                style: Style | None) -> tuple[float, float, float]:
-    """The carcass's width, depth and height (metres): the category's own draws, or under
-    ``proportions`` the style's places within the wider ranges."""
-    if style is None or style.proportions is None:
-        return width, depth, height
-    u, v, w = style.proportions
-    return (WIDE_WIDTH[0] + u * (WIDE_WIDTH[1] - WIDE_WIDTH[0]),
-            WIDE_DEPTH[0] + v * (WIDE_DEPTH[1] - WIDE_DEPTH[0]),
-            WIDE_HEIGHT[0] + w * (WIDE_HEIGHT[1] - WIDE_HEIGHT[0]))
 
 
 def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
@@ -63,7 +51,8 @@ def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     body_color = s.color("body_color", WOODS + BODY_WHITES)
     door_color = s.color("door_color", WOODS + BODY_WHITES)
 
-    width, depth, height = proportions(width, depth, height, style)  # after every draw, as they were
+    width, depth, height = proportioned(  # after every draw, which it leaves as they were
+        style, (width, depth, height), (WIDE_WIDTH, WIDE_DEPTH, WIDE_HEIGHT))
     s.params.update(width=width, depth=depth, height=height)
     xf = -depth / 2
     body = open_carcass(width, depth, height, wall, body_color)

@@ -15,7 +15,7 @@ from capt_env.objects.interiors import drawer_divider, drawer_frames
 from capt_env.objects.parts import BODY_WHITES, METALS, WOODS, box_from_bounds, open_carcass
 from capt_env.objects.sampling import ParamSampler
 from capt_env.objects.spec import JointSpec, LinkSpec, ObjectSpec
-from capt_env.objects.style import Style
+from capt_env.objects.style import Style, proportioned
 
 CATEGORY = "drawer_cabinet"
 GAP = 0.002  # m, between drawer fronts and around them
@@ -28,17 +28,6 @@ BOX_HEIGHT = (0.6, 0.8)
 """A drawer box's height as a share of its front's; under ``proportions`` it reaches up to 1."""
 NARROW = 0.18
 SHALLOW = 0.16
-
-
-def proportions(width: float, depth: float, box_frac: float,
-                style: Style | None) -> tuple[float, float, float]:
-    """The carcass's width and depth (metres) and the drawer boxes' share of their fronts' height: the
-    category's own draws, or under ``proportions`` the style's places within the wider ranges."""
-    if style is None or style.proportions is None:
-        return width, depth, box_frac
-    u, v, w = style.proportions
-    return (NARROW + u * (WIDTH[1] - NARROW), SHALLOW + v * (DEPTH[1] - SHALLOW),
-            BOX_HEIGHT[0] + w * (1.0 - BOX_HEIGHT[0]))
 
 
 def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
@@ -65,7 +54,8 @@ def make(instance_id: int, style: Style | None = None) -> ObjectSpec:
     inner_color = s.color("inner_color", WOODS)
     handle_color = s.color("handle_color", METALS)
 
-    width, depth, box_frac = proportions(width, depth, box_frac, style)  # after every draw, as they were
+    width, depth, box_frac = proportioned(  # after every draw, which it leaves as they were
+        style, (width, depth, box_frac), ((NARROW, WIDTH[1]), (SHALLOW, DEPTH[1]), (BOX_HEIGHT[0], 1.0)))
     s.params.update(width=width, depth=depth, drawer_box_height_frac=box_frac)
     height = count * slot + 2 * wall
     xf = -depth / 2

@@ -142,3 +142,12 @@ def lever_standoff(category_standoff: float, style: Style) -> float:
     standoff) at ``style.lever_stem`` 0, up to :data:`LEVER_MAX_STANDOFF` towards 1."""
     low = min(category_standoff, LEVER_MAX_STANDOFF)
     return low + style.lever_stem * (LEVER_MAX_STANDOFF - low)
+
+
+def proportioned(style: Style | None, own: tuple[float, ...],
+                 wider: tuple[tuple[float, float], ...]) -> tuple[float, ...]:
+    """A category's own draws ``own`` (metres or shares), or under ``proportions`` the style's places
+    within the ``wider`` (low, high) ranges, one range per value."""
+    if style is None or style.proportions is None:
+        return own
+    return tuple(low + u * (high - low) for u, (low, high) in zip(style.proportions, wider, strict=True))
